@@ -1,0 +1,86 @@
+#pragma once
+// The run configuration: a TOML file validated against one schema (src/config.cpp), which is
+// also the source of docs/config.md (`sheardiff config-doc`). Every key has a type, a range
+// and a unit; unknown keys and out-of-range values are errors naming the file and the key.
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sheardiff {
+
+enum class IntegratorType { Implicit, Euler, Heun };
+enum class MixRule { Area, Volume, Number };
+
+struct Config {
+  struct Scene {
+    std::string type = "simple_shear";
+  } scene;
+  struct ParticlesCfg {
+    std::int64_t n = 500;
+    MixRule mix = MixRule::Area;
+    double size_ratio = 1.4;
+    double phi_init = 0.7;
+    double aspect = 1.0;  // Ly / Lx of the initial cell
+    std::string init_file;
+    std::int64_t init_frame = -1;
+  } particles;
+  struct Flow {
+    double j = 1e-2;   // viscous number = gammadot in units P/eta
+    double lz = 1.0;   // monolayer thickness for stresses and wall load
+  } flow;
+  struct Lubrication {
+    bool enabled = true;
+    double delta = 0.01;
+    double h_max = 0.5;
+  } lubrication;
+  struct Contact {
+    double ktilde = 1e4;
+    double kt_ratio = 0.5;
+    double mu = 0.5;
+  } contact;
+  struct Integrator {
+    IntegratorType type = IntegratorType::Implicit;
+    double dt = 0.0;  // 0 = adaptive
+    double max_displacement = 1e-3;
+    double max_gap_fraction = 0.5;
+    double max_overlap_change = 1e-3;
+    double max_strain_step = 1e-2;
+    double explicit_safety = 0.5;
+  } integrator;
+  struct Neighbour {
+    double skin = 0.3;
+  } neighbour;
+  struct Run {
+    double strain = 1.0;
+    std::int64_t seed = 1;
+    std::int64_t max_steps = 0;  // 0 = unlimited
+    double transient_strain = 0.0;  // averages in summary.json start here
+  } run;
+  struct Output {
+    double frame_strain = 0.01;
+    bool velocities = true;
+    bool trajectory = true;
+  } output;
+};
+
+// Thrown for any invalid configuration; what() names the file, the key and the allowed range.
+struct ConfigError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Parse a TOML document (origin names it in errors) and apply "section.key=value" overrides.
+Config parse_config(const std::string& toml_text, const std::string& origin,
+                    const std::vector<std::string>& overrides = {});
+Config load_config(const std::filesystem::path& file,
+                   const std::vector<std::string>& overrides = {});
+// The resolved configuration as TOML (every key, defaults filled in).
+std::string to_toml(const Config& cfg);
+// Markdown table of every key: name, type, default, allowed range, unit, meaning.
+std::string config_reference_markdown();
+
+const char* to_string(IntegratorType t);
+const char* to_string(MixRule m);
+
+}  // namespace sheardiff

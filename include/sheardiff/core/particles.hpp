@@ -1,0 +1,35 @@
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "sheardiff/core/types.hpp"
+
+namespace sheardiff {
+
+// Where a particle's velocity comes from. Mobile particles carry unknowns; a particle of a
+// rigid wall body moves with that body (fixed, or floating in y).
+enum class Motion : std::uint8_t { Mobile = 0, FixedWall = 1, FloatingWall = 2 };
+
+// All discs of a scene. Mobile particles come first (indices 0 .. n_mobile-1), so the
+// unknown vector is indexed directly by particle index.
+struct Particles {
+  std::size_t n_mobile = 0;
+  std::vector<Vec2> position;    // current centres (wrapped at neighbour rebuilds)
+  std::vector<Vec2> unwrapped;   // centres integrated without wrapping (for displacements)
+  std::vector<double> radius;    // a_i = d_i / 2
+  std::vector<int> species;      // 0 small, 1 large
+  std::vector<Motion> motion;
+  std::vector<Vec3> velocity;    // last solved (u_x, u_y, omega)
+
+  std::size_t size() const { return position.size(); }
+  void resize(std::size_t n) {
+    position.resize(n, Vec2::Zero());
+    unwrapped.resize(n, Vec2::Zero());
+    radius.resize(n, 0.5);
+    species.resize(n, 0);
+    motion.resize(n, Motion::Mobile);
+    velocity.resize(n, Vec3::Zero());
+  }
+};
+
+}  // namespace sheardiff

@@ -1,0 +1,22 @@
+#pragma once
+// Basic algebra types. Units are those of docs/units.md: d = 1, P = 1, eta = 1.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace sheardiff {
+
+using Vec2 = Eigen::Vector2d;
+using Vec3 = Eigen::Vector3d;  // (u_x, u_y, omega_z) of one particle
+using Mat2 = Eigen::Matrix2d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using VecX = Eigen::VectorXd;
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+// 2D cross product z-component and the in-plane perpendicular t = z x n.
+inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+inline Vec2 perp(const Vec2& n) { return {-n.y(), n.x()}; }
+
+}  // namespace sheardiff

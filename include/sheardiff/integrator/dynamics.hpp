@@ -1,0 +1,91 @@
+#pragma once
+#include <optional>
+#include <vector>
+
+#include "sheardiff/core/box.hpp"
+#include "sheardiff/core/particles.hpp"
+#include "sheardiff/interactions/stokes_drag.hpp"
+#include "sheardiff/neighbour/neighbour_list.hpp"
+#include "sheardiff/solver/force_balance.hpp"
+
+namespace sheardiff {
+
+// Limits on one step (model.md section 7). fixed_dt > 0 switches the adaptive choice off.
+struct StepLimits {
+  double fixed_dt = 0.0;
+  double max_displacement = 1e-3;  // non-affine, d
+  double max_gap_fraction = 0.5;   // of (gap + delta s / 2)
+  double max_overlap_change = 1e-3;
+  double max_strain_step = 1e-2;
+  double explicit_dt = 0.0;        // stability cap of explicit springs (0 = none)
+};
+
+// The two rough walls: the bottom one fixed, the top one driven at Vx = gammadot H and floating
+// in y under the load P Lx lz. Indices refer to Particles.
+struct WallBodies {
+  std::vector<int> bottom, top;
+  double load = 0.0;
+  double free_fall_cap = 1.0;
+};
+
+// The state of a run and the operations an integrator composes: solve for velocities at the
+// current configuration, pick a step, move everything by a step. No policy lives here.
+class Dynamics {
+ public:
+  Dynamics(Particles particles, Box box, ShearFlow flow, ForceBalance force_balance,
+           NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls);
+
+  // Opens/closes contacts at the current configuration; call once at the start of a step.
+  void begin_step();
+  // Velocities at the current configuration; dt_implicit > 0 for implicit springs.
+  bool solve(double dt_implicit, Velocities& v);
+  // Largest step the limits allow for these velocities (fixed_dt if set).
+  double dt_limit(const Velocities& v) const;
+  // Move particles, walls and the Lees-Edwards offset by dt with velocities v; stretch the
+  // tangential springs with the slip of v; rebuild the neighbour list when the skin is used
+  // (unless allow_rebuild is false: a predictor move that restore() will undo).
+  void advance(double dt, const Velocities& v, bool allow_rebuild = true);
+  void finish_step() { ++steps_; }
+
+  struct Saved {
+    std::vector<Vec2> position, unwrapped;
+    std::vector<ContactHistory> contacts;
+    Box box;
+    double time;
+  };
+  Saved save() const;
+  // Undo moves made since save() with allow_rebuild = false.
+  void restore(const Saved& s);
+
+  const Particles& particles() const { return particles_; }
+  const Box& box() const { return box_; }
+  const ShearFlow& flow() const { return flow_; }
+  const NeighbourList& neighbours() const { return neighbours_; }
+  const ForceBalance& force_balance() const { return force_balance_; }
+  ForceBalance& force_balance() { return force_balance_; }
+  const StepLimits& limits() const { return limits_; }
+  const std::optional<WallBodies>& walls() const { return walls_; }
+  double time() const { return time_; }
+  double strain() const { return flow_.gammadot * time_; }
+  long steps() const { return steps_; }
+  // Gap between the walls (mean y of top minus bottom wall particles), or Ly.
+  double height() const;
+  const WallDrive* wall_drive() const { return walls_ ? &drive_ : nullptr; }
+
+ private:
+  void rebuild();
+
+  Particles particles_;
+  Box box_;
+  ShearFlow flow_;
+  ForceBalance force_balance_;
+  NeighbourList neighbours_;
+  StepLimits limits_;
+  std::optional<WallBodies> walls_;
+  WallDrive drive_;
+  double time_ = 0.0;
+  long steps_ = 0;
+  std::vector<Vec2> na_;  // scratch: non-affine displacement of the last step
+};
+
+}  // namespace sheardiff

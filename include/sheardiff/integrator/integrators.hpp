@@ -1,0 +1,62 @@
+#pragma once
+#include <memory>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/integrator/dynamics.hpp"
+
+namespace sheardiff {
+
+// A time-stepping policy over Dynamics (model.md section 7).
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  // Advance one step. Returns false if a linear solve failed (state is then unchanged).
+  virtual bool step(Dynamics& d) = 0;
+  // Velocities of the last completed step (the ones the particles moved with).
+  const Velocities& velocities() const { return last_; }
+  double last_dt() const { return dt_; }
+  long solves() const { return solves_; }
+  // Whether the springs sit inside the matrix (the force balance must keep the full pattern).
+  virtual bool implicit_springs() const { return false; }
+
+ protected:
+  Velocities last_;
+  double dt_ = 0.0;
+  long solves_ = 0;
+};
+
+// Springs explicit, one solve per step.
+class ExplicitEuler final : public Integrator {
+ public:
+  bool step(Dynamics& d) override;
+};
+
+// Springs explicit, predictor-corrector (two solves per step, second order).
+class Heun final : public Integrator {
+ public:
+  bool step(Dynamics& d) override;
+
+ private:
+  Velocities predictor_;
+};
+
+// Linearly implicit springs: (A + dt K) U = g, stable for any dt; dt chosen by accuracy from
+// the previous velocities, and the step is redone with a smaller dt if the solved velocities
+// overshoot the limits by more than `overshoot`.
+class ImplicitSprings final : public Integrator {
+ public:
+  explicit ImplicitSprings(double growth = 1.25, double overshoot = 1.5)
+      : growth_(growth), overshoot_(overshoot) {}
+  bool step(Dynamics& d) override;
+  bool implicit_springs() const override { return true; }
+  long redos() const { return redos_; }
+
+ private:
+  double growth_, overshoot_;
+  double next_dt_ = 0.0;
+  long redos_ = 0;
+};
+
+std::unique_ptr<Integrator> make_integrator(IntegratorType type);
+
+}  // namespace sheardiff

@@ -1,0 +1,96 @@
+#pragma once
+// H5MD 1.1 trajectory output/input (HDF5 C API kept out of this header) and the plain-text
+// position table reader. All errors are std::runtime_error naming the file and the object.
+#include <Eigen/Core>
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sheardiff/core/types.hpp"
+
+namespace sheardiff {
+
+struct TrajectoryLayout {
+  std::size_t n_particles = 0;           // all particles, mobile first then wall particles
+  std::vector<int> species;              // 0 small, 1 large (size n_particles)
+  std::vector<double> diameter;          // size n_particles
+  std::vector<int> motion;               // 0 mobile, 1 fixed wall, 2 floating wall
+  double lx = 1, ly = 1;                 // initial box edges
+  bool lees_edwards = false;             // y boundary: "periodic" if true, else "none"
+  bool write_velocity = true;            // write velocity (u_x,u_y) and angular_velocity (omega_z)
+  std::vector<std::string> observables;  // names of scalar observables written per frame
+  std::string creator_version;           // e.g. "0.1.0"
+  std::string config_toml;               // resolved config text, stored as /parameters@config
+};
+
+struct FrameData {
+  long step = 0;
+  double time = 0;
+  double lx = 1, ly = 1;                         // box edges at this frame
+  const std::vector<Vec2>* position = nullptr;   // wrapped positions, required
+  const std::vector<Vec2>* unwrapped = nullptr;  // optional; only honoured if given at frame 0
+  const std::vector<Vec3>* velocity = nullptr;   // (u_x,u_y,omega), required if write_velocity
+  std::vector<double> observables;               // same order as layout.observables
+};
+
+class H5mdWriter {
+ public:
+  // Creates or truncates `file`. Requires n_particles > 0 and per-particle arrays of that size.
+  H5mdWriter(const std::filesystem::path& file, const TrajectoryLayout& layout);
+  ~H5mdWriter();  // flush + close, never throws
+  H5mdWriter(const H5mdWriter&) = delete;
+  H5mdWriter& operator=(const H5mdWriter&) = delete;
+  H5mdWriter(H5mdWriter&&) noexcept;
+  H5mdWriter& operator=(H5mdWriter&&) noexcept;
+
+  // Appends one row to every time-dependent dataset. Validates all inputs before writing.
+  void write_frame(const FrameData& frame);
+  // Time-independent table /observables/<name>/value (rows, cols) with string-array
+  // attribute "columns" on the value dataset. The name must not already exist.
+  void write_table(const std::string& name, const std::vector<std::string>& columns,
+                   const Eigen::MatrixXd& values);
+  void flush();
+  long frames_written() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct H5mdFrame {
+  long step = 0;
+  double time = 0;
+  double lx = 0, ly = 0;
+  std::vector<Vec2> position;
+  std::vector<Vec2> unwrapped;  // empty if the file has no unwrapped_position
+  std::vector<Vec3> velocity;   // empty if the file has no velocity
+  std::vector<double> diameter;
+  std::vector<int> species;
+  std::vector<int> motion;
+};
+
+// frame = -1 means the last frame; otherwise 0-based; throws if out of range.
+H5mdFrame read_h5md_frame(const std::filesystem::path& file, long frame = -1);
+long count_h5md_frames(const std::filesystem::path& file);
+
+// Scalar observable time series; columns truncated to the shortest of step/time/value
+// so a file cut short by a crash still reads.
+struct ObservableSeries {
+  std::vector<long> step;
+  std::vector<double> time;
+  std::vector<double> value;
+};
+ObservableSeries read_h5md_observable(const std::filesystem::path& file, const std::string& name);
+
+// Plain-text table "x y diameter" (whitespace separated, '#' comments, blank lines ignored).
+// Throws naming the file and line number on a malformed line (wrong column count,
+// unparsable or non-finite number, diameter <= 0).
+struct TableConfiguration {
+  std::vector<Vec2> position;
+  std::vector<double> diameter;
+};
+TableConfiguration read_position_table(const std::filesystem::path& file);
+
+}  // namespace sheardiff

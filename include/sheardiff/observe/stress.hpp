@@ -1,0 +1,24 @@
+#pragma once
+#include "sheardiff/integrator/dynamics.hpp"
+
+namespace sheardiff {
+
+// Pair stress and contact statistics of one configuration (model.md section 9):
+// sigma = -(1 / (area lz)) sum over pairs of sym(l n (x) F_j), l = r in contact, s otherwise,
+// F_j the pair force on j. Tension positive: pressure = -(sigma_xx + sigma_yy) / 2.
+struct StressSample {
+  double sxx = 0, sxy = 0, syy = 0;
+  double pressure() const { return -0.5 * (sxx + syy); }
+  double shear_stress() const { return sxy; }
+  int contacts = 0;
+  double max_overlap = 0.0;
+  double mean_overlap = 0.0;
+  double top_wall_fx = 0.0;  // force of the suspension on the top wall (walls only)
+  double top_wall_fy = 0.0;
+  double bottom_wall_fx = 0.0;
+  double bottom_wall_fy = 0.0;
+};
+
+StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz);
+
+}  // namespace sheardiff

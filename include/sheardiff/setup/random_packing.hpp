@@ -1,0 +1,34 @@
+#pragma once
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/core/types.hpp"
+
+namespace sheardiff {
+
+// Diameters of a bidisperse mixture of n particles (small = 1, large = size_ratio), mixed by
+// equal total area, equal total volume or equal number; small first, then large.
+std::vector<int> bidisperse_species(std::int64_t n, MixRule mix, double size_ratio);
+
+struct Packing {
+  std::vector<Vec2> position;
+  std::vector<double> radius;
+  std::vector<int> species;
+  double lx = 0, ly = 0;
+};
+
+// Random non-overlapping discs in a periodic lx x ly cell at area fraction phi. Random
+// sequential addition up to phi = 0.5; denser targets are reached by shrinking the cell in
+// small steps and relaxing the overlaps with a soft repulsion (model.md section 2).
+// Reproducible for a given seed.
+Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,
+                       std::uint64_t seed);
+
+// Relax overlaps of discs in a cell periodic in x (and in y if periodic_y) by overdamped
+// steepest descent on a harmonic repulsion; returns the largest remaining overlap.
+double relax_overlaps(std::vector<Vec2>& position, const std::vector<double>& radius, double lx,
+                      double ly, bool periodic_y, double tolerance, int max_iterations);
+
+}  // namespace sheardiff

@@ -1,0 +1,44 @@
+#pragma once
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/integrator/integrators.hpp"
+#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/scene/scene.hpp"
+
+namespace sheardiff {
+
+// A run as a value: the scene, the engine composed for it and the integrator. Tests build one
+// from a Config (or a hand-made Scene) and step it.
+class Simulation {
+ public:
+  explicit Simulation(const Config& cfg);
+  Simulation(const Config& cfg, Scene scene);
+
+  // One integrator step; throws std::runtime_error if the linear solve fails.
+  void step();
+  StressSample sample() const { return measure_stress(*dynamics_, integrator_->velocities(), cfg_.flow.lz); }
+
+  const Config& config() const { return cfg_; }
+  Dynamics& dynamics() { return *dynamics_; }
+  const Dynamics& dynamics() const { return *dynamics_; }
+  const Integrator& integrator() const { return *integrator_; }
+
+ private:
+  Config cfg_;
+  std::unique_ptr<Integrator> integrator_;
+  std::unique_ptr<Dynamics> dynamics_;
+};
+
+// Contact stability limit of explicit springs for these parameters (model.md section 7).
+double explicit_stability_dt(const Config& cfg);
+
+// Runs cfg to its end, writing trajectory.h5, summary.json and config.toml into out_dir.
+// Returns the summary.
+nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
+                                bool progress);
+
+}  // namespace sheardiff

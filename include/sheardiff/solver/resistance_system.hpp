@@ -1,0 +1,71 @@
+#pragma once
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "sheardiff/core/particles.hpp"
+#include "sheardiff/neighbour/neighbour_list.hpp"
+
+namespace sheardiff {
+
+// The per-step force/torque balance A U + b V = g of the mobile particles (model.md section 6),
+// with A = drag + sum of pair blocks (+ dt K for implicit springs) symmetric positive definite.
+// Unknowns: `dof` per mobile particle (3 = u_x, u_y, omega; 2 = no rotation), plus the
+// optional y velocity V of one floating wall, eliminated by two back-solves on one factor.
+// The sparsity pattern (and the symbolic factorisation) are rebuilt only with the neighbour
+// list: pairs out of range keep their structural zeros.
+class ResistanceSystem {
+ public:
+  explicit ResistanceSystem(int dof = 3)
+      : dof_(dof), llt_(std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>()) {}
+
+  int dof() const { return dof_; }
+  std::size_t unknowns() const { return static_cast<std::size_t>(dof_) * n_; }
+
+  // New pattern from the neighbour list. diagonal_only: no pair ever couples two particles
+  // (no lubrication, explicit springs), so A is diagonal and no factorisation is needed.
+  void set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs, const Particles& p,
+                   bool diagonal_only);
+
+  void clear();
+  // One-body terms: resistance on the diagonal and force on the right-hand side.
+  void add_self(int i, const Vec3& resistance, const Vec3& force);
+  // Pair k of the list: generalised pair force -M U_pair + f, with U_pair = (U_i, U_j + known_j).
+  // j_floating: j belongs to the floating wall, whose y velocity is the extra unknown V.
+  void add_pair(std::size_t k, const Pair& pr, const Mat6& m, const Vec6& f, const Vec3& known_j,
+                bool j_mobile, bool j_floating);
+
+  // Solve. With a floating wall, its y force balance reads b.U + c V = wall_rhs - load.
+  // Returns false if the factorisation failed (matrix not positive definite).
+  bool solve(VecX& u);
+  bool solve_with_floating_wall(VecX& u, double load, double free_fall_cap, double& v);
+
+  // Diagnostics: relative residual |A U + b V - g| / |g| of the last solve.
+  double residual(const VecX& u, double v) const;
+  const Eigen::SparseMatrix<double>& matrix() const { return a_; }
+  const VecX& rhs() const { return g_; }
+  std::size_t factorisations() const { return factorisations_; }
+  std::size_t analyses() const { return analyses_; }
+
+ private:
+  int index(int row, int col) const;
+  void scatter(int bi, int bj, const Mat6& m, int oi, int oj);
+
+  int dof_;
+  std::size_t n_ = 0;
+  bool diagonal_only_ = false;
+  Eigen::SparseMatrix<double> a_;  // lower triangle
+  VecX g_, b_;
+  double c_ = 0.0, wall_rhs_ = 0.0;
+  std::vector<int> diag_idx_;   // dof*dof entries per particle (-1 above the diagonal)
+  std::vector<int> pair_idx_;   // dof*dof entries per listed pair, -1 for non mobile-mobile
+  std::vector<double> diag_;    // diagonal_only storage
+  // Held by pointer: Eigen's factorisations are not movable.
+  std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>> llt_;
+  bool pattern_analysed_ = false;
+  std::size_t factorisations_ = 0, analyses_ = 0;
+};
+
+}  // namespace sheardiff

@@ -1,0 +1,419 @@
+#include "sheardiff/config.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+#include <variant>
+
+namespace sheardiff {
+
+const char* to_string(IntegratorType t) {
+  switch (t) {
+    case IntegratorType::Implicit: return "implicit";
+    case IntegratorType::Euler: return "euler";
+    case IntegratorType::Heun: return "heun";
+  }
+  return "?";
+}
+const char* to_string(MixRule m) {
+  switch (m) {
+    case MixRule::Area: return "area";
+    case MixRule::Volume: return "volume";
+    case MixRule::Number: return "number";
+  }
+  return "?";
+}
+
+namespace {
+
+using Value = std::variant<double, std::int64_t, bool, std::string>;
+
+enum class Kind { Real, Integer, Boolean, Text, Choice };
+
+struct KeySpec {
+  std::string key;  // "section.name"
+  Kind kind;
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;  // lo excluded
+  std::vector<std::string> choices;
+  std::string unit;
+  std::string doc;
+  std::function<Value(const Config&)> get;
+  std::function<void(Config&, const Value&)> set;
+};
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+template <typename T>
+KeySpec real(std::string key, T Config::*sec, double T::*field, double lo, double hi, bool lo_open,
+             std::string unit, std::string doc) {
+  KeySpec k{std::move(key), Kind::Real, lo, hi, lo_open, {}, std::move(unit), std::move(doc), {}, {}};
+  k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
+  k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<double>(v); };
+  return k;
+}
+template <typename T>
+KeySpec integer(std::string key, T Config::*sec, std::int64_t T::*field, double lo, double hi,
+                std::string unit, std::string doc) {
+  KeySpec k{std::move(key), Kind::Integer, lo, hi, false, {}, std::move(unit), std::move(doc), {}, {}};
+  k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
+  k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::int64_t>(v); };
+  return k;
+}
+template <typename T>
+KeySpec boolean(std::string key, T Config::*sec, bool T::*field, std::string doc) {
+  KeySpec k{std::move(key), Kind::Boolean, -kInf, kInf, false, {}, "", std::move(doc), {}, {}};
+  k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
+  k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<bool>(v); };
+  return k;
+}
+template <typename T>
+KeySpec text(std::string key, T Config::*sec, std::string T::*field, std::string doc) {
+  KeySpec k{std::move(key), Kind::Text, -kInf, kInf, false, {}, "", std::move(doc), {}, {}};
+  k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
+  k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::string>(v); };
+  return k;
+}
+KeySpec choice(std::string key, std::vector<std::string> choices, std::string doc,
+               std::function<Value(const Config&)> get,
+               std::function<void(Config&, const Value&)> set) {
+  return KeySpec{std::move(key), Kind::Choice, -kInf, kInf, false, std::move(choices), "",
+                 std::move(doc), std::move(get), std::move(set)};
+}
+
+const std::vector<KeySpec>& schema() {
+  using C = Config;
+  static const std::vector<KeySpec> specs = [] {
+    std::vector<KeySpec> s;
+    s.push_back(choice(
+        "scene.type", {"simple_shear"},
+        "Scene: `simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate.",
+        [](const C& c) { return Value{c.scene.type}; },
+        [](C& c, const Value& v) { c.scene.type = std::get<std::string>(v); }));
+    s.push_back(integer("particles.N", &C::particles, &C::ParticlesCfg::n, 2, 1e6, "",
+                        "Number of mobile particles."));
+    s.push_back(choice(
+        "particles.mix", {"area", "volume", "number"},
+        "How small (d) and large (size_ratio d) particles are mixed: equal total area, equal "
+        "total volume, or equal numbers.",
+        [](const C& c) { return Value{std::string(to_string(c.particles.mix))}; },
+        [](C& c, const Value& v) {
+          const auto& t = std::get<std::string>(v);
+          c.particles.mix = t == "area" ? MixRule::Area : t == "volume" ? MixRule::Volume
+                                                                          : MixRule::Number;
+        }));
+    s.push_back(real("particles.size_ratio", &C::particles, &C::ParticlesCfg::size_ratio, 1.0, 3.0,
+                     false, "", "Diameter of large particles over small ones."));
+    s.push_back(real("particles.phi_init", &C::particles, &C::ParticlesCfg::phi_init, 0.0, 0.9,
+                     true, "",
+                     "Area fraction of the initial random placement (above ~0.55 it is reached "
+                     "by compression with a soft repulsion)."));
+    s.push_back(real("particles.aspect", &C::particles, &C::ParticlesCfg::aspect, 0.05, 20.0, false,
+                     "", "Initial cell height over width, Ly/Lx."));
+    s.push_back(text("particles.init_file", &C::particles, &C::ParticlesCfg::init_file,
+                     "Optional initial configuration: an H5MD file (`.h5`) or a plain table "
+                     "`x y diameter`; empty = random placement. Relative paths are taken from "
+                     "the config file's folder."));
+    s.push_back(integer("particles.init_frame", &C::particles, &C::ParticlesCfg::init_frame, -1,
+                        1e12, "", "Frame of an H5MD init_file to start from (-1 = last)."));
+    s.push_back(real("flow.J", &C::flow, &C::Flow::j, 0.0, 10.0, true, "1 (= gammadot eta/P)",
+                     "Viscous number; in model units this is the shear rate gammadot."));
+    s.push_back(real("flow.lz", &C::flow, &C::Flow::lz, 0.0, 100.0, true, "d",
+                     "Thickness given to the monolayer for stresses and the wall load P Lx lz."));
+    s.push_back(boolean("lubrication.enabled", &C::lubrication, &C::Lubrication::enabled,
+                        "Pairwise lubrication and lubrication-matched contact dashpots."));
+    s.push_back(real("lubrication.delta", &C::lubrication, &C::Lubrication::delta, 0.0, 0.5, true,
+                     "1 (reduced gap)", "Regularisation of the lubrication singularity."));
+    s.push_back(real("lubrication.h_max", &C::lubrication, &C::Lubrication::h_max, 0.0, 1.0, true,
+                     "1 (reduced gap)",
+                     "Lubrication cut-off: active for 0 < h < h_max (must be < 1)."));
+    s.push_back(real("contact.ktilde", &C::contact, &C::Contact::ktilde, 1.0, 1e9, false,
+                     "P d (so kn = ktilde)", "Normal contact stiffness kn / (P d)."));
+    s.push_back(real("contact.kt_ratio", &C::contact, &C::Contact::kt_ratio, 0.0, 1.0, false, "",
+                     "Tangential over normal stiffness kt / kn."));
+    s.push_back(real("contact.mu", &C::contact, &C::Contact::mu, 0.0, 10.0, false, "",
+                     "Coulomb friction coefficient (0 = frictionless, no tangential springs)."));
+    s.push_back(choice(
+        "integrator.type", {"implicit", "euler", "heun"},
+        "Spring integration: `implicit` (linearly implicit springs, dt set by accuracy), "
+        "`euler` or `heun` (explicit springs, dt capped by the contact stability limit).",
+        [](const C& c) { return Value{std::string(to_string(c.integrator.type))}; },
+        [](C& c, const Value& v) {
+          const auto& t = std::get<std::string>(v);
+          c.integrator.type = t == "implicit" ? IntegratorType::Implicit
+                              : t == "euler"  ? IntegratorType::Euler
+                                              : IntegratorType::Heun;
+        }));
+    s.push_back(real("integrator.dt", &C::integrator, &C::Integrator::dt, 0.0, 1e3, false,
+                     "eta/P", "Fixed time step; 0 = adaptive (limits below)."));
+    s.push_back(real("integrator.max_displacement", &C::integrator,
+                     &C::Integrator::max_displacement, 0.0, 0.1, true, "d",
+                     "Adaptive dt: largest non-affine displacement of any particle per step."));
+    s.push_back(real("integrator.max_gap_fraction", &C::integrator,
+                     &C::Integrator::max_gap_fraction, 0.0, 1.0, true, "",
+                     "Adaptive dt: largest closing of any lubricated gap per step, as a fraction "
+                     "of (gap + delta a_mean)."));
+    s.push_back(real("integrator.max_overlap_change", &C::integrator,
+                     &C::Integrator::max_overlap_change, 0.0, 0.1, true, "d",
+                     "Adaptive dt: largest change of any contact overlap per step."));
+    s.push_back(real("integrator.max_strain_step", &C::integrator,
+                     &C::Integrator::max_strain_step, 0.0, 0.1, true, "1 (strain)",
+                     "Adaptive dt: upper bound gammadot dt."));
+    s.push_back(real("integrator.explicit_safety", &C::integrator,
+                     &C::Integrator::explicit_safety, 0.0, 1.0, true, "",
+                     "Explicit integrators: dt is at most this fraction of the contact "
+                     "stability limit 2 R/k."));
+    s.push_back(real("neighbour.skin", &C::neighbour, &C::Neighbour::skin, 0.0, 5.0, true, "d",
+                     "Verlet skin; the list is rebuilt when a particle has moved skin/2."));
+    s.push_back(real("run.strain", &C::run, &C::Run::strain, 0.0, 1e5, true, "1",
+                     "Total strain gammadot t to simulate."));
+    s.push_back(integer("run.seed", &C::run, &C::Run::seed, 0, 9.0e18, "",
+                        "Seed of the random initial placement."));
+    s.push_back(integer("run.max_steps", &C::run, &C::Run::max_steps, 0, 9.0e18, "",
+                        "Stop after this many steps even if run.strain is not reached (0 = no "
+                        "limit)."));
+    s.push_back(real("run.transient_strain", &C::run, &C::Run::transient_strain, 0.0, 1e5, false,
+                     "1 (strain)",
+                     "Strain after which time averages (summary.json) are accumulated."));
+    s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, true,
+                     "1 (strain)", "Strain between two trajectory frames."));
+    s.push_back(boolean("output.velocities", &C::output, &C::Output::velocities,
+                        "Write velocities and angular velocities to the trajectory."));
+    s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
+                        "Write DIR/trajectory.h5 (summary.json is always written)."));
+    return s;
+  }();
+  return specs;
+}
+
+const KeySpec* find_spec(const std::string& key) {
+  for (const auto& k : schema())
+    if (k.key == key) return &k;
+  return nullptr;
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string suggestion(const std::string& key) {
+  std::string best;
+  std::size_t best_d = 4;
+  for (const auto& k : schema()) {
+    const std::size_t d = edit_distance(key, k.key);
+    if (d < best_d) best_d = d, best = k.key;
+  }
+  return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
+}
+
+std::string range_text(const KeySpec& k) {
+  switch (k.kind) {
+    case Kind::Boolean: return "true or false";
+    case Kind::Text: return "a string";
+    case Kind::Choice: {
+      std::string s = "one of";
+      for (const auto& c : k.choices) s += " \"" + c + "\"";
+      return s;
+    }
+    case Kind::Integer: return fmt::format("an integer in [{:g}, {:g}]", k.lo, k.hi);
+    case Kind::Real:
+      return fmt::format("a number in {}{:g}, {:g}]", k.lo_open ? "(" : "[", k.lo, k.hi);
+  }
+  return "";
+}
+
+[[noreturn]] void fail(const std::string& origin, const std::string& key, const std::string& what) {
+  throw ConfigError(fmt::format("{}: {}: {}", origin, key, what));
+}
+
+std::string describe(const toml::node& n) {
+  std::ostringstream os;
+  if (n.is_string()) os << '"' << *n.value<std::string>() << '"';
+  else if (n.is_table()) os << "a table";
+  else if (n.is_array()) os << "an array";
+  else n.visit([&](const auto& v) { os << v; });
+  return os.str();
+}
+
+Value convert(const toml::node& node, const KeySpec& k, const std::string& origin) {
+  const auto bad = [&] {
+    fail(origin, k.key, fmt::format("value {} is not allowed; expected {}", describe(node),
+                                    range_text(k)));
+  };
+  Value v;
+  switch (k.kind) {
+    case Kind::Real:
+      if (node.is_floating_point()) v = *node.value<double>();
+      else if (node.is_integer()) v = static_cast<double>(*node.value<std::int64_t>());
+      else bad();
+      if (!std::isfinite(std::get<double>(v))) bad();
+      break;
+    case Kind::Integer:
+      if (!node.is_integer()) bad();
+      v = *node.value<std::int64_t>();
+      break;
+    case Kind::Boolean:
+      if (!node.is_boolean()) bad();
+      v = *node.value<bool>();
+      break;
+    case Kind::Text:
+    case Kind::Choice:
+      if (!node.is_string()) bad();
+      v = *node.value<std::string>();
+      break;
+  }
+  if (k.kind == Kind::Real || k.kind == Kind::Integer) {
+    const double x = k.kind == Kind::Real ? std::get<double>(v)
+                                          : static_cast<double>(std::get<std::int64_t>(v));
+    if (x < k.lo || x > k.hi || (k.lo_open && x == k.lo)) bad();
+  }
+  if (k.kind == Kind::Choice &&
+      std::find(k.choices.begin(), k.choices.end(), std::get<std::string>(v)) == k.choices.end())
+    bad();
+  return v;
+}
+
+void apply_table(Config& cfg, const toml::table& root, const std::string& origin) {
+  for (const auto& [section, node] : root) {
+    const std::string sec(section.str());
+    const auto* table = node.as_table();
+    if (!table) {
+      fail(origin, sec,
+           fmt::format("top-level keys are not allowed; expected a [section] table{}",
+                       suggestion(sec)));
+    }
+    for (const auto& [name, value] : *table) {
+      const std::string key = sec + "." + std::string(name.str());
+      const KeySpec* spec = find_spec(key);
+      if (!spec) fail(origin, key, "unknown key" + suggestion(key));
+      spec->set(cfg, convert(value, *spec, origin));
+    }
+  }
+}
+
+void check_combinations(const Config& c, const std::string& origin) {
+  if (c.particles.init_file.empty() && c.particles.phi_init > 0.86)
+    fail(origin, "particles.phi_init",
+         fmt::format("random placement with compression cannot reach {:g}; allowed up to 0.86 "
+                     "without particles.init_file",
+                     c.particles.phi_init));
+  if (c.run.transient_strain >= c.run.strain)
+    fail(origin, "run.transient_strain",
+         fmt::format("{:g} must be smaller than run.strain = {:g}", c.run.transient_strain,
+                     c.run.strain));
+  if (c.output.frame_strain > c.run.strain)
+    fail(origin, "output.frame_strain",
+         fmt::format("{:g} is larger than run.strain = {:g}: no frame would be written",
+                     c.output.frame_strain, c.run.strain));
+}
+
+}  // namespace
+
+Config parse_config(const std::string& toml_text, const std::string& origin,
+                    const std::vector<std::string>& overrides) {
+  Config cfg;
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, origin);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw ConfigError(fmt::format("{}:{}:{}: not valid TOML: {}", origin, b.line, b.column,
+                                  e.description()));
+  }
+  apply_table(cfg, root, origin);
+  for (const auto& o : overrides) {
+    const auto eq = o.find('=');
+    const auto dot = o.find('.');
+    if (eq == std::string::npos || dot == std::string::npos || dot > eq)
+      throw ConfigError(
+          fmt::format("--set {}: expected section.key=value (for example flow.J=1e-3)", o));
+    const std::string key = o.substr(0, eq);
+    const std::string val = o.substr(eq + 1);
+    const KeySpec* spec = find_spec(key);
+    if (!spec) fail("--set", key, "unknown key" + suggestion(key));
+    toml::table t;
+    try {
+      t = toml::parse("v = " + val);
+    } catch (const toml::parse_error&) {
+      // Bare words are taken as strings so that --set integrator.type=heun works unquoted.
+      try {
+        t = toml::parse("v = \"" + val + "\"");
+      } catch (const toml::parse_error&) {
+        fail("--set", key, fmt::format("cannot read value '{}'", val));
+      }
+    }
+    spec->set(cfg, convert(*t.get("v"), *spec, "--set"));
+  }
+  check_combinations(cfg, origin);
+  return cfg;
+}
+
+Config load_config(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  std::ifstream in(file);
+  if (!in) throw ConfigError(fmt::format("{}: cannot open the config file", file.string()));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  Config cfg = parse_config(ss.str(), file.string(), overrides);
+  auto& init = cfg.particles.init_file;
+  if (!init.empty() && std::filesystem::path(init).is_relative())
+    init = (file.parent_path() / init).lexically_normal().string();
+  return cfg;
+}
+
+std::string to_toml(const Config& cfg) {
+  std::map<std::string, toml::table> sections;
+  std::vector<std::string> order;
+  for (const auto& k : schema()) {
+    const auto dot = k.key.find('.');
+    const std::string sec = k.key.substr(0, dot), name = k.key.substr(dot + 1);
+    if (!sections.count(sec)) order.push_back(sec);
+    auto& t = sections[sec];
+    std::visit([&](const auto& x) { t.insert(name, x); }, k.get(cfg));
+  }
+  std::ostringstream os;
+  for (const auto& sec : order) os << '[' << sec << "]\n" << sections[sec] << "\n\n";
+  return os.str();
+}
+
+std::string config_reference_markdown() {
+  std::ostringstream os;
+  os << "| key | type | default | allowed | unit | meaning |\n|---|---|---|---|---|---|\n";
+  const Config def;
+  for (const auto& k : schema()) {
+    std::string dflt;
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, std::string>) dflt = "\"" + x + "\"";
+          else if constexpr (std::is_same_v<T, bool>) dflt = x ? "true" : "false";
+          else dflt = fmt::format("{:g}", static_cast<double>(x));
+        },
+        k.get(def));
+    const char* type = k.kind == Kind::Real      ? "real"
+                       : k.kind == Kind::Integer ? "integer"
+                       : k.kind == Kind::Boolean ? "bool"
+                                                 : "string";
+    os << "| `" << k.key << "` | " << type << " | " << dflt << " | " << range_text(k) << " | "
+       << (k.unit.empty() ? "-" : k.unit) << " | " << k.doc << " |\n";
+  }
+  return os.str();
+}
+
+}  // namespace sheardiff

@@ -1,0 +1,130 @@
+#include "sheardiff/integrator/dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sheardiff {
+
+Dynamics::Dynamics(Particles particles, Box box, ShearFlow flow, ForceBalance force_balance,
+                   NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls)
+    : particles_(std::move(particles)),
+      box_(box),
+      flow_(flow),
+      force_balance_(std::move(force_balance)),
+      neighbours_(std::move(neighbours)),
+      limits_(limits),
+      walls_(std::move(walls)) {
+  if (walls_) {
+    drive_.load = walls_->load;
+    drive_.free_fall_cap = walls_->free_fall_cap;
+  }
+  rebuild();
+}
+
+void Dynamics::rebuild() {
+  neighbours_.rebuild(particles_, box_);
+  force_balance_.on_rebuild(particles_, neighbours_.pairs());
+}
+
+double Dynamics::height() const {
+  if (!walls_) return box_.ly;
+  double top = 0.0, bottom = 0.0;
+  for (int k : walls_->top) top += particles_.position[k].y();
+  for (int k : walls_->bottom) bottom += particles_.position[k].y();
+  return top / walls_->top.size() - bottom / walls_->bottom.size();
+}
+
+void Dynamics::begin_step() {
+  ForceBalance::update_contacts(particles_, box_, neighbours_.pairs());
+  if (walls_) drive_.vx = flow_.gammadot * height();
+}
+
+bool Dynamics::solve(double dt_implicit, Velocities& v) {
+  return force_balance_.solve(particles_, box_, flow_, neighbours_.pairs(), dt_implicit,
+                              wall_drive(), v);
+}
+
+double Dynamics::dt_limit(const Velocities& v) const {
+  if (limits_.fixed_dt > 0.0) return limits_.fixed_dt;
+  constexpr double kBig = std::numeric_limits<double>::infinity();
+  double dt = flow_.gammadot > 0.0 ? limits_.max_strain_step / flow_.gammadot : kBig;
+  double vmax = 0.0;
+  for (std::size_t i = 0; i < particles_.n_mobile; ++i) {
+    const Vec3 na = v.u[i] - flow_.velocity(particles_.position[i]);
+    vmax = std::max(vmax, na.head<2>().squaredNorm());
+  }
+  vmax = std::sqrt(vmax);
+  if (walls_) vmax = std::max(vmax, std::abs(v.wall_v));
+  if (vmax > 0.0) dt = std::min(dt, limits_.max_displacement / vmax);
+
+  const auto& pairs = neighbours_.pairs();
+  const auto& terms = force_balance_.terms();
+  const double delta = force_balance_.lubrication() ? force_balance_.lubrication()->delta : 0.0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const PairTerm& t = terms[k];
+    if (!t.on) continue;
+    const Vec3 uj = v.u[pairs[k].j] + t.image_j;
+    const double opening = t.g.n.dot(uj.head<2>() - v.u[pairs[k].i].head<2>());
+    if (pairs[k].contact.active) {
+      if (opening != 0.0) dt = std::min(dt, limits_.max_overlap_change / std::abs(opening));
+    } else if (opening < 0.0) {
+      const double room = (t.g.r - t.g.s) + 0.5 * delta * t.g.s;
+      dt = std::min(dt, limits_.max_gap_fraction * room / -opening);
+    }
+  }
+  if (limits_.explicit_dt > 0.0) dt = std::min(dt, limits_.explicit_dt);
+  return dt;
+}
+
+void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
+  // Springs first: they stretch with the slip at the geometry of the start of the step.
+  const FrictionalContact& law = force_balance_.contact();
+  if (law.has_friction()) {
+    auto& pairs = neighbours_.pairs();
+    const auto& terms = force_balance_.terms();
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      Pair& pr = pairs[k];
+      if (!pr.contact.active) continue;
+      Vec6 u;
+      u << v.u[pr.i], v.u[pr.j] + terms[k].image_j;
+      pr.contact.xi += FrictionalContact::slip_rate(terms[k].g, u) * dt;
+      law.apply_coulomb(terms[k].g, pr.contact.xi);
+    }
+  }
+  na_.resize(particles_.size());
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Vec2 step = v.u[i].head<2>() * dt;
+    if (particles_.motion[i] == Motion::FixedWall) {
+      na_[i].setZero();
+      continue;
+    }
+    na_[i] = step - flow_.velocity(particles_.position[i]).head<2>() * dt;
+    particles_.position[i] += step;
+    particles_.unwrapped[i] += step;
+    particles_.velocity[i] = v.u[i];
+  }
+  if (box_.lees_edwards) box_.le_offset += flow_.gammadot * box_.ly * dt;
+  time_ += dt;
+  neighbours_.advance(na_, flow_.gammadot * dt);
+  if (allow_rebuild && neighbours_.needs_rebuild()) rebuild();
+}
+
+Dynamics::Saved Dynamics::save() const {
+  Saved s{particles_.position, particles_.unwrapped, {}, box_, time_};
+  s.contacts.reserve(neighbours_.pairs().size());
+  for (const Pair& pr : neighbours_.pairs()) s.contacts.push_back(pr.contact);
+  return s;
+}
+
+void Dynamics::restore(const Saved& s) {
+  particles_.position = s.position;
+  particles_.unwrapped = s.unwrapped;
+  box_ = s.box;
+  time_ = s.time;
+  auto& pairs = neighbours_.pairs();
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k].contact = s.contacts[k];
+  // The Verlet bookkeeping of the undone move stays counted: that only rebuilds earlier.
+}
+
+}  // namespace sheardiff

@@ -1,0 +1,72 @@
+#include "sheardiff/integrator/integrators.hpp"
+
+#include <algorithm>
+
+namespace sheardiff {
+
+bool ExplicitEuler::step(Dynamics& d) {
+  d.begin_step();
+  if (!d.solve(0.0, last_)) return false;
+  ++solves_;
+  dt_ = d.dt_limit(last_);
+  d.advance(dt_, last_);
+  d.finish_step();
+  return true;
+}
+
+bool Heun::step(Dynamics& d) {
+  d.begin_step();
+  if (!d.solve(0.0, predictor_)) return false;
+  ++solves_;
+  dt_ = d.dt_limit(predictor_);
+  const Dynamics::Saved start = d.save();
+  d.advance(dt_, predictor_, /*allow_rebuild=*/false);
+  const bool ok = d.solve(0.0, last_);
+  ++solves_;
+  d.restore(start);
+  if (!ok) return false;
+  for (std::size_t i = 0; i < last_.u.size(); ++i) last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
+  last_.wall_v = 0.5 * (last_.wall_v + predictor_.wall_v);
+  d.advance(dt_, last_);
+  d.finish_step();
+  return true;
+}
+
+bool ImplicitSprings::step(Dynamics& d) {
+  d.begin_step();
+  const bool fixed = d.limits().fixed_dt > 0.0;
+  double dt = fixed ? d.limits().fixed_dt : next_dt_;
+  if (dt <= 0.0) {
+    // First step: the limits evaluated on the explicit-spring velocities.
+    if (!d.solve(0.0, last_)) return false;
+    ++solves_;
+    dt = d.dt_limit(last_);
+  }
+  for (int attempt = 0;; ++attempt) {
+    if (!d.solve(dt, last_)) return false;
+    ++solves_;
+    if (fixed) break;
+    const double allowed = d.dt_limit(last_);
+    if (dt <= overshoot_ * allowed || attempt == 3) {
+      next_dt_ = std::min(growth_ * dt, allowed);
+      break;
+    }
+    dt = allowed;
+    ++redos_;
+  }
+  dt_ = dt;
+  d.advance(dt_, last_);
+  d.finish_step();
+  return true;
+}
+
+std::unique_ptr<Integrator> make_integrator(IntegratorType type) {
+  switch (type) {
+    case IntegratorType::Euler: return std::make_unique<ExplicitEuler>();
+    case IntegratorType::Heun: return std::make_unique<Heun>();
+    case IntegratorType::Implicit: return std::make_unique<ImplicitSprings>();
+  }
+  return nullptr;
+}
+
+}  // namespace sheardiff

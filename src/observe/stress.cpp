@@ -1,0 +1,50 @@
+#include "sheardiff/observe/stress.hpp"
+
+#include <algorithm>
+
+namespace sheardiff {
+
+StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz) {
+  StressSample s;
+  const auto& pairs = d.neighbours().pairs();
+  const auto& terms = d.force_balance().terms();
+  const Particles& p = d.particles();
+  double overlap_sum = 0.0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const PairTerm& t = terms[k];
+    if (!t.on) continue;
+    const Pair& pr = pairs[k];
+    const Vec6 f = t.force(v.u[pr.i], v.u[pr.j]);
+    const Vec2 fj = f.segment<2>(3);
+    const bool contact = pr.contact.active;
+    const double l = contact ? t.g.r : t.g.s;
+    s.sxx -= l * t.g.n.x() * fj.x();
+    s.syy -= l * t.g.n.y() * fj.y();
+    s.sxy -= 0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x());
+    if (contact) {
+      ++s.contacts;
+      const double ov = std::max(t.g.overlap(), 0.0);
+      s.max_overlap = std::max(s.max_overlap, ov);
+      overlap_sum += ov;
+    }
+    switch (p.motion[pr.j]) {
+      case Motion::FloatingWall:
+        s.top_wall_fx += fj.x();
+        s.top_wall_fy += fj.y();
+        break;
+      case Motion::FixedWall:
+        s.bottom_wall_fx += fj.x();
+        s.bottom_wall_fy += fj.y();
+        break;
+      case Motion::Mobile: break;
+    }
+  }
+  const double area = d.box().lx * d.height() * lz;
+  s.sxx /= area;
+  s.syy /= area;
+  s.sxy /= area;
+  s.mean_overlap = s.contacts ? overlap_sum / s.contacts : 0.0;
+  return s;
+}
+
+}  // namespace sheardiff

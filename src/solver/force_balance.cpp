@@ -1,0 +1,92 @@
+#include "sheardiff/solver/force_balance.hpp"
+
+#include <stdexcept>
+
+namespace sheardiff {
+
+namespace {
+Vec2 pair_vector(const Particles& p, const Box& box, const Pair& pr) {
+  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
+}
+}  // namespace
+
+ForceBalance::ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact,
+                           int dof, bool implicit_springs)
+    : lubrication_(lubrication),
+      contact_(contact),
+      system_(dof),
+      diagonal_only_(!lubrication && !implicit_springs) {}
+
+void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs) {
+  terms_.assign(pairs.size(), PairTerm{});
+  system_.set_pattern(p.n_mobile, pairs, p, diagonal_only_);
+}
+
+void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs) {
+  for (Pair& pr : pairs) {
+    const double r = pair_vector(p, box, pr).norm();
+    const bool touching = r <= p.radius[pr.i] + p.radius[pr.j];
+    if (touching != pr.contact.active) pr.contact = ContactHistory{touching, 0.0};
+  }
+}
+
+bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
+                         const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
+                         Velocities& out) {
+  if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
+  if (dt_implicit > 0.0 && diagonal_only_)
+    throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
+  system_.clear();
+  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+    const Vec3 drag = StokesDrag::resistance(p.radius[i]);
+    system_.add_self(static_cast<int>(i), drag, drag.cwiseProduct(flow.velocity(p.position[i])));
+  }
+  const bool friction = contact_.has_friction();
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const Pair& pr = pairs[k];
+    PairTerm& term = terms_[k];
+    term.g = PairGeometry::make(pair_vector(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+    const bool contact = pr.contact.active;
+    const bool lubricated = lubrication_ && lubrication_->acts(term.g.h);
+    term.on = contact || lubricated;
+    if (!term.on) continue;
+    term.m.setZero();
+    term.f.setZero();
+    if (lubricated || (contact && lubrication_))
+      term.m = lubrication_->coefficients(term.g.ai, term.g.aj, term.g.h).matrix(term.g.n, term.g.t);
+    if (contact) {
+      term.f = contact_.spring_force(term.g, friction ? pr.contact.xi : 0.0);
+      term.sliding = friction && contact_.at_coulomb_limit(term.g, pr.contact.xi);
+      if (dt_implicit > 0.0) term.m += dt_implicit * contact_.stiffness(term.g, term.sliding);
+    }
+    const Motion mj = p.motion[pr.j];
+    term.image_j = Vec3::Zero();
+    Vec3 known = Vec3::Zero();
+    if (mj == Motion::Mobile) known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
+    else if (mj == Motion::FloatingWall && wall) known.x() = wall->vx;
+    system_.add_pair(k, pr, term.m, term.f, known, mj == Motion::Mobile,
+                     mj == Motion::FloatingWall && wall);
+  }
+
+  double v = 0.0;
+  const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v)
+                       : system_.solve(u_);
+  if (!ok) return false;
+  if (check_residual_) residual_ = system_.residual(u_, v);
+
+  const int d = system_.dof();
+  out.u.resize(p.size());
+  out.wall_v = v;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    switch (p.motion[i]) {
+      case Motion::Mobile:
+        out.u[i] = Vec3(u_[d * i], u_[d * i + 1], d == 3 ? u_[d * i + 2] : 0.0);
+        break;
+      case Motion::FixedWall: out.u[i].setZero(); break;
+      case Motion::FloatingWall: out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero(); break;
+    }
+  }
+  return true;
+}
+
+}  // namespace sheardiff

@@ -1,0 +1,167 @@
+#include "sheardiff/solver/resistance_system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sheardiff {
+
+int ResistanceSystem::index(int row, int col) const {
+  const int* inner = a_.innerIndexPtr();
+  const int* begin = inner + a_.outerIndexPtr()[col];
+  const int* end = inner + a_.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  if (it == end || *it != row) throw std::logic_error("ResistanceSystem: entry not in pattern");
+  return static_cast<int>(it - inner);
+}
+
+void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs,
+                                   const Particles& p, bool diagonal_only) {
+  n_ = n_mobile;
+  diagonal_only_ = diagonal_only;
+  const int d = dof_;
+  const auto nu = static_cast<Eigen::Index>(unknowns());
+  g_.setZero(nu);
+  b_.setZero(nu);
+  if (diagonal_only_) {
+    diag_.assign(unknowns(), 0.0);
+    pair_idx_.clear();
+    return;
+  }
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(n_ * d * (d + 1) / 2 + pairs.size() * d * d);
+  for (std::size_t i = 0; i < n_; ++i)
+    for (int r = 0; r < d; ++r)
+      for (int c = 0; c <= r; ++c) trip.emplace_back(d * i + r, d * i + c, 0.0);
+  for (const Pair& pr : pairs) {
+    if (p.motion[pr.j] != Motion::Mobile) continue;
+    const int hi = std::max(pr.i, pr.j), lo = std::min(pr.i, pr.j);
+    for (int r = 0; r < d; ++r)
+      for (int c = 0; c < d; ++c) trip.emplace_back(d * hi + r, d * lo + c, 0.0);
+  }
+  a_.resize(nu, nu);
+  a_.setFromTriplets(trip.begin(), trip.end());
+  a_.makeCompressed();
+
+  diag_idx_.assign(n_ * d * d, -1);
+  for (std::size_t i = 0; i < n_; ++i)
+    for (int r = 0; r < d; ++r)
+      for (int c = 0; c <= r; ++c)
+        diag_idx_[(i * d + r) * d + c] = index(static_cast<int>(d * i + r), static_cast<int>(d * i + c));
+  pair_idx_.assign(pairs.size() * d * d, -1);
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const Pair& pr = pairs[k];
+    if (p.motion[pr.j] != Motion::Mobile) continue;
+    const int hi = std::max(pr.i, pr.j), lo = std::min(pr.i, pr.j);
+    for (int r = 0; r < d; ++r)
+      for (int c = 0; c < d; ++c)
+        pair_idx_[(k * d + r) * d + c] = index(d * hi + r, d * lo + c);
+  }
+  llt_->analyzePattern(a_);
+  pattern_analysed_ = true;
+  ++analyses_;
+}
+
+void ResistanceSystem::clear() {
+  if (diagonal_only_) std::fill(diag_.begin(), diag_.end(), 0.0);
+  else std::fill(a_.valuePtr(), a_.valuePtr() + a_.nonZeros(), 0.0);
+  g_.setZero();
+  b_.setZero();
+  c_ = 0.0;
+  wall_rhs_ = 0.0;
+}
+
+void ResistanceSystem::add_self(int i, const Vec3& resistance, const Vec3& force) {
+  for (int r = 0; r < dof_; ++r) {
+    const std::size_t row = static_cast<std::size_t>(dof_) * i + r;
+    if (diagonal_only_) diag_[row] += resistance[r];
+    else a_.valuePtr()[diag_idx_[(row)*dof_ + r]] += resistance[r];
+    g_[static_cast<Eigen::Index>(row)] += force[r];
+  }
+}
+
+void ResistanceSystem::add_pair(std::size_t k, const Pair& pr, const Mat6& m, const Vec6& f,
+                                const Vec3& known_j, bool j_mobile, bool j_floating) {
+  const int d = dof_;
+  double* val = diagonal_only_ ? nullptr : a_.valuePtr();
+  // Right-hand side: spring force minus the resistance against j's known velocity.
+  const Vec6 rhs = f - m.rightCols<3>() * known_j;
+  for (int r = 0; r < d; ++r) g_[d * pr.i + r] += rhs[r];
+  if (!diagonal_only_) {
+    for (int r = 0; r < d; ++r)
+      for (int c = 0; c <= r; ++c) val[diag_idx_[(pr.i * d + r) * d + c]] += m(r, c);
+  } else {
+    for (int r = 0; r < d; ++r) diag_[d * pr.i + r] += m(r, r);
+  }
+  if (j_mobile) {
+    for (int r = 0; r < d; ++r) g_[d * pr.j + r] += rhs[3 + r];
+    if (!diagonal_only_) {
+      for (int r = 0; r < d; ++r)
+        for (int c = 0; c <= r; ++c) val[diag_idx_[(pr.j * d + r) * d + c]] += m(3 + r, 3 + c);
+      // Block of row particle max(i, j) and column particle min(i, j).
+      const bool j_hi = pr.j > pr.i;
+      for (int r = 0; r < d; ++r)
+        for (int c = 0; c < d; ++c)
+          val[pair_idx_[(k * d + r) * d + c]] += j_hi ? m(3 + r, c) : m(r, 3 + c);
+    } else {
+      for (int r = 0; r < d; ++r) diag_[d * pr.j + r] += m(3 + r, 3 + r);
+    }
+  } else if (j_floating) {
+    for (int r = 0; r < d; ++r) b_[d * pr.i + r] += m(r, 4);
+    c_ += m(4, 4);
+    wall_rhs_ += rhs[4];
+  }
+}
+
+bool ResistanceSystem::solve(VecX& u) {
+  if (diagonal_only_) {
+    u = g_.array() / Eigen::Map<const VecX>(diag_.data(), g_.size()).array();
+    return u.allFinite();
+  }
+  llt_->factorize(a_);
+  ++factorisations_;
+  if (llt_->info() != Eigen::Success) return false;
+  u = llt_->solve(g_);
+  return u.allFinite();
+}
+
+bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double free_fall_cap,
+                                                double& v) {
+  VecX u1;
+  if (diagonal_only_) {
+    const auto diag = Eigen::Map<const VecX>(diag_.data(), g_.size()).array();
+    u = g_.array() / diag;
+    u1 = b_.array() / diag;
+  } else {
+    llt_->factorize(a_);
+    ++factorisations_;
+    if (llt_->info() != Eigen::Success) return false;
+    u = llt_->solve(g_);
+    u1 = llt_->solve(b_);
+  }
+  // Schur complement of the bordered system [[A, b], [b^T, c]].
+  const double schur = c_ - b_.dot(u1);
+  const double rhs = wall_rhs_ - load - b_.dot(u);
+  if (schur > 0.0 && std::abs(rhs) < free_fall_cap * schur) {
+    v = rhs / schur;
+  } else {
+    // Nothing (or almost nothing) holds the wall: it falls at a capped speed onto the packing.
+    v = std::copysign(free_fall_cap, rhs);
+  }
+  u -= v * u1;
+  return u.allFinite() && std::isfinite(v);
+}
+
+double ResistanceSystem::residual(const VecX& u, double v) const {
+  VecX au;
+  if (diagonal_only_) {
+    au = Eigen::Map<const VecX>(diag_.data(), g_.size()).cwiseProduct(u);
+  } else {
+    au = a_.selfadjointView<Eigen::Lower>() * u;
+  }
+  au += v * b_;
+  const double gn = g_.norm();
+  return (au - g_).norm() / (gn > 0 ? gn : 1.0);
+}
+
+}  // namespace sheardiff
