@@ -39,7 +39,9 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   system_.clear();
   for (std::size_t i = 0; i < p.n_mobile; ++i) {
     const Vec3 drag = StokesDrag::resistance(p.radius[i]);
-    system_.add_self(static_cast<int>(i), drag, drag.cwiseProduct(flow.velocity(p.position[i])));
+    Vec3 force = drag.cwiseProduct(flow.velocity(p.position[i]));
+    if (!p.external.empty()) force += p.external[i];
+    system_.add_self(static_cast<int>(i), drag, force);
   }
   const bool friction = contact_.has_friction();
   for (std::size_t k = 0; k < pairs.size(); ++k) {

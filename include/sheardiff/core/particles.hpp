@@ -20,6 +20,9 @@ struct Particles {
   std::vector<int> species;      // 0 small, 1 large
   std::vector<Motion> motion;
   std::vector<Vec3> velocity;    // last solved (u_x, u_y, omega)
+  // Optional imposed force and torque on mobile particles (empty = none); tests and
+  // sedimentation-like scenes use it.
+  std::vector<Vec3> external;
 
   std::size_t size() const { return position.size(); }
   void resize(std::size_t n) {

@@ -58,6 +58,10 @@ class Dynamics {
   void restore(const Saved& s);
 
   const Particles& particles() const { return particles_; }
+  // Mutable access for set-up and tests (e.g. external forces); positions changed here take
+  // effect at the next rebuild, so call rebuild_now() after moving particles.
+  Particles& particles_mut() { return particles_; }
+  void rebuild_now() { rebuild(); }
   const Box& box() const { return box_; }
   const ShearFlow& flow() const { return flow_; }
   const NeighbourList& neighbours() const { return neighbours_; }
