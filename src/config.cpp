@@ -95,8 +95,10 @@ const std::vector<KeySpec>& schema() {
   static const std::vector<KeySpec> specs = [] {
     std::vector<KeySpec> s;
     s.push_back(choice(
-        "scene.type", {"simple_shear"},
-        "Scene: `simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate.",
+        "scene.type", {"simple_shear", "pressure_shear"},
+        "Scene: `simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear "
+        "rate; `pressure_shear` = plane shear between rough walls, the top wall floating under "
+        "the load P Lx lz (the packing dilates to phi(J)).",
         [](const C& c) { return Value{c.scene.type}; },
         [](C& c, const Value& v) { c.scene.type = std::get<std::string>(v); }));
     s.push_back(integer("particles.N", &C::particles, &C::ParticlesCfg::n, 2, 1e6, "",
@@ -184,6 +186,28 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("run.transient_strain", &C::run, &C::Run::transient_strain, 0.0, 1e5, false,
                      "1 (strain)",
                      "Strain after which time averages (summary.json) are accumulated."));
+    s.push_back(real("walls.free_fall_speed", &C::walls, &C::Walls::free_fall_speed, 0.0, 100.0,
+                     true, "P d / eta",
+                     "pressure_shear: largest |V| of the top wall while (almost) nothing holds it, "
+                     "so that it settles onto the packing instead of jumping."));
+    s.push_back(real("walls.jitter", &C::walls, &C::Walls::jitter, 0.0, 1.0, false, "radius",
+                     "pressure_shear: random y offset of wall particle centres (roughness)."));
+    s.push_back(real("steady.window", &C::steady, &C::Steady::window, 0.0, 1e4, true, "1 (strain)",
+                     "pressure_shear: steady state = no drift of H and mu between the two halves "
+                     "of the last window of this strain."));
+    s.push_back(real("steady.h_tolerance", &C::steady, &C::Steady::h_tolerance, 0.0, 1.0, true,
+                     "", "Relative change of mean H allowed between the window halves."));
+    s.push_back(real("steady.mu_tolerance", &C::steady, &C::Steady::mu_tolerance, 0.0, 10.0, true,
+                     "", "Change of mean mu allowed between the window halves."));
+    s.push_back(real("steady.measure_strain", &C::steady, &C::Steady::measure_strain, 0.0, 1e5,
+                     false, "1 (strain)",
+                     "pressure_shear: strain simulated after steady state, then stop (0 = run to "
+                     "run.strain; run.strain always caps the run)."));
+    s.push_back(real("observables.wall_exclusion", &C::observables,
+                     &C::Observables::wall_exclusion, 0.0, 100.0, false, "d",
+                     "pressure_shear: slab next to each wall left out of the bulk phi."));
+    s.push_back(real("observables.profile_bin", &C::observables, &C::Observables::profile_bin, 0.0,
+                     100.0, true, "d", "Bin width of the phi, u_x and T profiles across the gap."));
     s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, true,
                      "1 (strain)", "Strain between two trajectory frames."));
     s.push_back(boolean("output.velocities", &C::output, &C::Output::velocities,

@@ -10,6 +10,8 @@
 #include <fstream>
 
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/observe/observer.hpp"
+#include "sheardiff/observe/pressure_cell.hpp"
 
 namespace sheardiff {
 
@@ -73,19 +75,6 @@ void Simulation::step() {
 
 namespace {
 
-struct Averages {
-  double weight = 0, sxy = 0, pressure = 0, contacts = 0, mean_overlap = 0;
-  double max_overlap = 0;
-  void add(const StressSample& s, double w) {
-    weight += w;
-    sxy += w * s.shear_stress();
-    pressure += w * s.pressure();
-    contacts += w * s.contacts;
-    mean_overlap += w * s.mean_overlap;
-    max_overlap = std::max(max_overlap, s.max_overlap);
-  }
-};
-
 void write_text_atomically(const std::filesystem::path& file, const std::string& text) {
   const auto tmp = file.string() + ".tmp";
   {
@@ -98,6 +87,13 @@ void write_text_atomically(const std::filesystem::path& file, const std::string&
 
 }  // namespace
 
+std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg) {
+  std::vector<std::unique_ptr<Observer>> obs;
+  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
+  if (cfg.scene.type == "pressure_shear") obs.push_back(std::make_unique<PressureCellObserver>(cfg));
+  return obs;
+}
+
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress) {
   std::filesystem::create_directories(out_dir);
@@ -107,9 +103,11 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   Simulation sim(cfg);
   Dynamics& d = sim.dynamics();
   const Particles& p = d.particles();
+  auto observers = make_observers(cfg);
 
-  const std::vector<std::string> names = {"strain", "shear_stress", "pressure", "sigma_xx",
-                                          "sigma_yy", "contacts", "max_overlap", "height"};
+  std::vector<std::string> names;
+  for (const auto& o : observers)
+    for (auto& n : o->frame_names()) names.push_back(n);
   std::unique_ptr<H5mdWriter> writer;
   if (cfg.output.trajectory) {
     TrajectoryLayout layout;
@@ -118,7 +116,7 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
     for (double a : p.radius) layout.diameter.push_back(2.0 * a);
     for (Motion m : p.motion) layout.motion.push_back(static_cast<int>(m));
     layout.lx = d.box().lx;
-    layout.ly = d.box().ly;
+    layout.ly = d.height();
     layout.lees_edwards = d.box().lees_edwards;
     layout.write_velocity = cfg.output.velocities;
     layout.observables = names;
@@ -130,19 +128,23 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   const bool tty = progress && isatty(fileno(stderr));
   const auto t0 = std::chrono::steady_clock::now();
   auto last_print = t0;
-  Averages avg;
   double next_frame = cfg.output.frame_strain;
-  const double gd = cfg.flow.j;
-  while (d.strain() < cfg.run.strain * (1.0 - 1e-12) &&
-         (cfg.run.max_steps == 0 || d.steps() < cfg.run.max_steps)) {
+  std::vector<double> values;
+  const auto finished = [&] {
+    for (const auto& o : observers)
+      if (o->done(d)) return true;
+    return d.strain() >= cfg.run.strain * (1.0 - 1e-12) ||
+           (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
+  };
+  while (!finished()) {
     sim.step();
-    const bool frame_due = d.strain() >= next_frame * (1.0 - 1e-12);
-    const bool averaging = d.strain() > cfg.run.transient_strain;
-    if (!frame_due && !averaging) continue;
     const StressSample s = sim.sample();
-    if (averaging) avg.add(s, sim.integrator().last_dt());
-    if (frame_due) {
+    const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
+    for (const auto& o : observers) o->on_step(view);
+    if (d.strain() >= next_frame * (1.0 - 1e-12)) {
       while (next_frame <= d.strain() * (1.0 + 1e-12)) next_frame += cfg.output.frame_strain;
+      values.clear();
+      for (const auto& o : observers) o->on_frame(view, values);
       if (writer) {
         FrameData f;
         f.step = d.steps();
@@ -152,8 +154,7 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
         f.position = &p.position;
         f.unwrapped = &p.unwrapped;
         f.velocity = &sim.integrator().velocities().u;
-        f.observables = {d.strain(), s.shear_stress(), s.pressure(), s.sxx, s.syy,
-                         static_cast<double>(s.contacts), s.max_overlap, d.height()};
+        f.observables = values;
         writer->write_frame(f);
       }
     }
@@ -169,10 +170,8 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
     }
   }
   if (tty) std::fprintf(stderr, "\n");
-  if (writer) writer->flush();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  const double w = avg.weight > 0 ? avg.weight : 1.0;
   nlohmann::json js;
   js["scene"] = cfg.scene.type;
   js["N"] = cfg.particles.n;
@@ -183,22 +182,18 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   js["steps"] = d.steps();
   js["steps_per_strain"] = d.steps() / std::max(d.strain(), 1e-300);
   js["wall_seconds"] = wall;
-  js["ms_per_step"] = 1e3 * wall / std::max<long>(d.steps(), 1);
+  js["ms_per_step"] = 1e3 * wall / static_cast<double>(std::max<long>(d.steps(), 1));
   js["neighbour_rebuilds"] = d.neighbours().rebuilds();
-  js["max_overlap"] = avg.max_overlap;
-  js["mean_overlap"] = avg.mean_overlap / w;
-  js["shear_stress"] = avg.sxy / w;
-  js["pressure"] = avg.pressure / w;
-  js["contacts_per_particle"] = avg.contacts / w / cfg.particles.n;
-  js["viscosity"] = avg.sxy / w / gd;
-  js["averaged_from_strain"] = cfg.run.transient_strain;
   js["lx"] = d.box().lx;
   js["ly"] = d.height();
-  js["phi"] = [&] {
+  for (const auto& o : observers) o->finish(d, js, writer.get());
+  if (!js.contains("phi")) {
     double area = 0;
     for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
-    return area / (d.box().lx * d.height());
-  }();
+    js["phi"] = area / (d.box().lx * d.height());
+  }
+  if (writer) writer->flush();
+  writer.reset();
   write_text_atomically(out_dir / "summary.json", js.dump(2) + "\n");
   return js;
 }

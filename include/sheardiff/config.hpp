@@ -58,6 +58,20 @@ struct Config {
     std::int64_t max_steps = 0;  // 0 = unlimited
     double transient_strain = 0.0;  // averages in summary.json start here
   } run;
+  struct Walls {
+    double free_fall_speed = 0.5;  // |V| cap while nothing holds the top wall
+    double jitter = 0.4;           // y disorder of wall particle centres, in radii
+  } walls;
+  struct Steady {
+    double window = 2.0;          // strain window of the no-drift test
+    double h_tolerance = 0.01;    // relative drift of H allowed between the window halves
+    double mu_tolerance = 0.05;   // drift of mu allowed between the window halves
+    double measure_strain = 0.0;  // strain run after steady state (0 = until run.strain)
+  } steady;
+  struct Observables {
+    double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi
+    double profile_bin = 0.5;     // d, bin width of the profiles across the gap
+  } observables;
   struct Output {
     double frame_strain = 0.01;
     bool velocities = true;

@@ -36,6 +36,12 @@ double Dynamics::height() const {
 }
 
 void Dynamics::begin_step() {
+  // The rebuild waits until here so that pair terms stay those of the last solve until then
+  // (observers read forces after the move).
+  if (rebuild_due_) {
+    rebuild();
+    rebuild_due_ = false;
+  }
   ForceBalance::update_contacts(particles_, box_, neighbours_.pairs());
   if (walls_) drive_.vx = flow_.gammadot * height();
 }
@@ -107,7 +113,7 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   if (box_.lees_edwards) box_.le_offset += flow_.gammadot * box_.ly * dt;
   time_ += dt;
   neighbours_.advance(na_, flow_.gammadot * dt);
-  if (allow_rebuild && neighbours_.needs_rebuild()) rebuild();
+  if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 
 Dynamics::Saved Dynamics::save() const {

@@ -49,12 +49,16 @@ Packing packing_from_file(const Config& cfg) {
 
 }  // namespace
 
+Packing initial_packing(const Config& cfg) {
+  return cfg.particles.init_file.empty()
+             ? random_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
+                              cfg.particles.phi_init, cfg.particles.aspect,
+                              static_cast<std::uint64_t>(cfg.run.seed))
+             : packing_from_file(cfg);
+}
+
 Scene build_simple_shear(const Config& cfg) {
-  Packing pk = cfg.particles.init_file.empty()
-                   ? random_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
-                                    cfg.particles.phi_init, cfg.particles.aspect,
-                                    static_cast<std::uint64_t>(cfg.run.seed))
-                   : packing_from_file(cfg);
+  Packing pk = initial_packing(cfg);
   Scene sc;
   sc.particles.resize(pk.position.size());
   sc.particles.n_mobile = pk.position.size();
@@ -73,6 +77,7 @@ Scene build_simple_shear(const Config& cfg) {
 
 Scene build_scene(const Config& cfg) {
   if (cfg.scene.type == "simple_shear") return build_simple_shear(cfg);
+  if (cfg.scene.type == "pressure_shear") return build_pressure_shear(cfg);
   throw ConfigError(fmt::format("scene.type: unknown scene \"{}\"", cfg.scene.type));
 }
 

@@ -71,8 +71,11 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   }
 
   double v = 0.0;
-  const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v)
+  bool capped = false;
+  const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v,
+                                                          capped)
                        : system_.solve(u_);
+  out.wall_free_fall = capped;
   if (!ok) return false;
   if (check_residual_) residual_ = system_.residual(u_, v);
 

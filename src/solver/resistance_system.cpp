@@ -126,7 +126,7 @@ bool ResistanceSystem::solve(VecX& u) {
 }
 
 bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double free_fall_cap,
-                                                double& v) {
+                                                double& v, bool& capped) {
   VecX u1;
   if (diagonal_only_) {
     const auto diag = Eigen::Map<const VecX>(diag_.data(), g_.size()).array();
@@ -142,7 +142,8 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
   // Schur complement of the bordered system [[A, b], [b^T, c]].
   const double schur = c_ - b_.dot(u1);
   const double rhs = wall_rhs_ - load - b_.dot(u);
-  if (schur > 0.0 && std::abs(rhs) < free_fall_cap * schur) {
+  capped = !(schur > 0.0 && std::abs(rhs) < free_fall_cap * schur);
+  if (!capped) {
     v = rhs / schur;
   } else {
     // Nothing (or almost nothing) holds the wall: it falls at a capped speed onto the packing.

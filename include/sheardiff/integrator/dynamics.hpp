@@ -42,8 +42,9 @@ class Dynamics {
   // Largest step the limits allow for these velocities (fixed_dt if set).
   double dt_limit(const Velocities& v) const;
   // Move particles, walls and the Lees-Edwards offset by dt with velocities v; stretch the
-  // tangential springs with the slip of v; rebuild the neighbour list when the skin is used
-  // (unless allow_rebuild is false: a predictor move that restore() will undo).
+  // tangential springs with the slip of v; when the skin is used up the neighbour list is
+  // rebuilt at the next begin_step() (never after a predictor move, allow_rebuild = false,
+  // that restore() will undo).
   void advance(double dt, const Velocities& v, bool allow_rebuild = true);
   void finish_step() { ++steps_; }
 
@@ -89,6 +90,7 @@ class Dynamics {
   WallDrive drive_;
   double time_ = 0.0;
   long steps_ = 0;
+  bool rebuild_due_ = false;
   std::vector<Vec2> na_;  // scratch: non-affine displacement of the last step
 };
 

@@ -18,6 +18,9 @@ struct Scene {
 
 // Lees-Edwards periodic cell at fixed area fraction and shear rate (volume imposed).
 Scene build_simple_shear(const Config& cfg);
+// Plane shear between two rough walls of frozen particles, periodic in x; the bottom wall
+// fixed, the top wall driven at gammadot H and floating in y under the load P Lx lz.
+Scene build_pressure_shear(const Config& cfg);
 // Dispatch on scene.type.
 Scene build_scene(const Config& cfg);
 

@@ -26,6 +26,9 @@ struct Packing {
 Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,
                        std::uint64_t seed);
 
+// The mobile particles of cfg: a random packing, or the configuration of particles.init_file.
+Packing initial_packing(const struct Config& cfg);
+
 // Relax overlaps of discs in a cell periodic in x (and in y if periodic_y) by overdamped
 // steepest descent on a harmonic repulsion; returns the largest remaining overlap.
 double relax_overlaps(std::vector<Vec2>& position, const std::vector<double>& radius, double lx,

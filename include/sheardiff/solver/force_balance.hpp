@@ -42,6 +42,7 @@ struct PairTerm {
 struct Velocities {
   std::vector<Vec3> u;  // every particle: mobile solved, wall particles their body's motion
   double wall_v = 0.0;  // y velocity of the floating wall
+  bool wall_free_fall = false;  // V was capped: the wall is not (yet) held by the packing
 };
 
 // Pair laws + drag -> the linear system -> velocities. One loop over the listed pairs serves

@@ -40,7 +40,9 @@ class ResistanceSystem {
   // Solve. With a floating wall, its y force balance reads b.U + c V = wall_rhs - load.
   // Returns false if the factorisation failed (matrix not positive definite).
   bool solve(VecX& u);
-  bool solve_with_floating_wall(VecX& u, double load, double free_fall_cap, double& v);
+  // capped: set when |V| hit free_fall_cap (the load is then not balanced).
+  bool solve_with_floating_wall(VecX& u, double load, double free_fall_cap, double& v,
+                                bool& capped);
 
   // Diagnostics: relative residual |A U + b V - g| / |g| of the last solve.
   double residual(const VecX& u, double v) const;

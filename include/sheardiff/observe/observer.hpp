@@ -1,0 +1,56 @@
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "sheardiff/integrator/dynamics.hpp"
+#include "sheardiff/observe/stress.hpp"
+
+namespace sheardiff {
+
+class H5mdWriter;
+
+// What an observer sees after a step.
+struct StepView {
+  const Dynamics& dynamics;
+  const Velocities& velocities;
+  const StressSample& stress;
+  double dt;
+};
+
+// Reads the state after steps; never changes it. A run composes only the observers its scene
+// and config ask for.
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  // Scalar observables written to every trajectory frame (names fixed for the run).
+  virtual std::vector<std::string> frame_names() const { return {}; }
+  // Called on frame steps; appends one value per frame_names() entry.
+  virtual void on_frame(const StepView&, std::vector<double>& values) { (void)values; }
+  // Called after every step (time averages).
+  virtual void on_step(const StepView&) {}
+  // Whether the run may stop now (e.g. measured long enough after steady state).
+  virtual bool done(const Dynamics&) const { return false; }
+  // Results into summary.json, tables into the trajectory (writer may be null).
+  virtual void finish(const Dynamics&, nlohmann::json& summary, H5mdWriter* writer) {
+    (void)summary;
+    (void)writer;
+  }
+};
+
+// Stress and contact statistics of any scene, time-averaged after run.transient_strain.
+class RheologyObserver final : public Observer {
+ public:
+  explicit RheologyObserver(double transient_strain) : transient_(transient_strain) {}
+  std::vector<std::string> frame_names() const override;
+  void on_frame(const StepView& v, std::vector<double>& values) override;
+  void on_step(const StepView& v) override;
+  void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+
+ private:
+  double transient_;
+  double weight_ = 0, sxy_ = 0, pressure_ = 0, contacts_ = 0, mean_overlap_ = 0;
+  double max_overlap_ = 0;
+};
+
+}  // namespace sheardiff

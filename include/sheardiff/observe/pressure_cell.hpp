@@ -1,0 +1,44 @@
+#pragma once
+#include <vector>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/observe/observer.hpp"
+
+namespace sheardiff {
+
+// Area of the disc (centre height yc, radius a) lying between heights y1 < y2.
+double disc_area_between(double yc, double a, double y1, double y2);
+
+// Observables of the pressure-imposed plane shear cell (model.md section 9): gap H, bulk phi,
+// mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
+// drift of H and mu, and phi(y), u_x(y), T(y) profiles averaged over the steady window.
+class PressureCellObserver final : public Observer {
+ public:
+  explicit PressureCellObserver(const Config& cfg);
+  std::vector<std::string> frame_names() const override;
+  void on_frame(const StepView& v, std::vector<double>& values) override;
+  void on_step(const StepView& v) override;
+  bool done(const Dynamics& d) const override;
+  void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+
+  bool steady() const { return steady_at_ >= 0.0; }
+  double steady_strain() const { return steady_from_; }
+  // Bulk area fraction of the current configuration.
+  static double bulk_phi(const Dynamics& d, double exclusion);
+
+ private:
+  void accumulate_profiles(const StepView& v);
+
+  Config::Steady steady_cfg_;
+  double exclusion_, bin_, pressure_, lz_, run_strain_;
+  std::vector<double> hist_strain_, hist_h_, hist_mu_;
+  double steady_at_ = -1.0;    // strain at which steadiness was detected
+  double steady_from_ = -1.0;  // start of the no-drift window
+  // Steady-window time averages.
+  double w_ = 0, h_ = 0, phi_ = 0, phi2_ = 0, mu_top_ = 0, mu_bottom_ = 0, p_meas_ = 0;
+  double max_p_err_ = 0;
+  long free_fall_steps_ = 0;
+  std::vector<double> prof_w_, prof_area_, prof_n_, prof_ux_, prof_ux2_, prof_uy2_;
+};
+
+}  // namespace sheardiff

@@ -1,0 +1,39 @@
+#include "sheardiff/observe/observer.hpp"
+
+#include <algorithm>
+
+namespace sheardiff {
+
+std::vector<std::string> RheologyObserver::frame_names() const {
+  return {"strain", "shear_stress", "pressure", "sigma_xx", "sigma_yy", "contacts", "max_overlap"};
+}
+
+void RheologyObserver::on_frame(const StepView& v, std::vector<double>& values) {
+  const StressSample& s = v.stress;
+  values.insert(values.end(), {v.dynamics.strain(), s.shear_stress(), s.pressure(), s.sxx, s.syy,
+                               static_cast<double>(s.contacts), s.max_overlap});
+}
+
+void RheologyObserver::on_step(const StepView& v) {
+  const StressSample& s = v.stress;
+  max_overlap_ = std::max(max_overlap_, s.max_overlap);
+  if (v.dynamics.strain() <= transient_) return;
+  weight_ += v.dt;
+  sxy_ += v.dt * s.shear_stress();
+  pressure_ += v.dt * s.pressure();
+  contacts_ += v.dt * s.contacts;
+  mean_overlap_ += v.dt * s.mean_overlap;
+}
+
+void RheologyObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
+  const double w = weight_ > 0 ? weight_ : 1.0;
+  js["max_overlap"] = max_overlap_;
+  js["mean_overlap"] = mean_overlap_ / w;
+  js["shear_stress"] = sxy_ / w;
+  js["pressure"] = pressure_ / w;
+  js["contacts_per_particle"] = contacts_ / w / static_cast<double>(d.particles().n_mobile);
+  js["viscosity"] = d.flow().gammadot > 0 ? sxy_ / w / d.flow().gammadot : 0.0;
+  js["averaged_from_strain"] = transient_;
+}
+
+}  // namespace sheardiff
