@@ -48,6 +48,11 @@ class ResistanceSystem {
   double residual(const VecX& u, double v) const;
   const Eigen::SparseMatrix<double>& matrix() const { return a_; }
   const VecX& rhs() const { return g_; }
+  // The floating wall's border of the system: column b, diagonal c and right-hand side
+  // (before the load is subtracted).
+  const VecX& wall_column() const { return b_; }
+  double wall_diagonal() const { return c_; }
+  double wall_rhs() const { return wall_rhs_; }
   std::size_t factorisations() const { return factorisations_; }
   std::size_t analyses() const { return analyses_; }
 

@@ -1,0 +1,168 @@
+// The pressure-imposed plane shear cell: floating wall force balance, the bordered system,
+// dilatancy and the robustness of the wall (issue: pressure-imposed plane shear).
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseLU>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/simulation.hpp"
+
+namespace sheardiff {
+namespace {
+
+Config cell_config(std::int64_t n, double j, double ktilde, double phi_init, std::int64_t seed) {
+  Config c;
+  c.scene.type = "pressure_shear";
+  c.particles.n = n;
+  c.particles.phi_init = phi_init;
+  c.particles.aspect = 1.0;
+  c.flow.j = j;
+  c.contact.ktilde = ktilde;
+  c.run.seed = seed;
+  return c;
+}
+
+// Steps until the packing holds the top wall (no free fall for 20 consecutive steps).
+void settle(Simulation& sim) {
+  int held = 0;
+  for (int k = 0; k < 20000 && held < 20; ++k) {
+    sim.step();
+    held = sim.integrator().velocities().wall_free_fall ? 0 : held + 1;
+  }
+  ASSERT_EQ(held, 20) << "the top wall never settled onto the packing";
+}
+
+nlohmann::json run_summary(Config c, const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("sheardiff_test_" + name);
+  std::filesystem::remove_all(dir);
+  c.output.trajectory = false;
+  nlohmann::json js = run_to_directory(c, dir, false);
+  std::filesystem::remove_all(dir);
+  return js;
+}
+
+TEST(PressureShear, WallForceEqualsLoadEveryStep) {
+  Config c = cell_config(120, 1e-2, 1e4, 0.75, 3);
+  Simulation sim(c);
+  settle(sim);
+  const double load = sim.dynamics().box().lx * c.flow.lz;  // P Lx lz, P = 1
+  for (int k = 0; k < 300; ++k) {
+    sim.step();
+    ASSERT_FALSE(sim.integrator().velocities().wall_free_fall) << "step " << k;
+    const StressSample s = sim.sample();
+    // The y balance of the wall is one row of the solved system: round-off only.
+    ASSERT_NEAR(s.top_wall_fy / load, 1.0, 1e-9) << "step " << k;
+  }
+}
+
+TEST(PressureShear, TwoSolvesEqualBorderedSystem) {
+  Config c = cell_config(80, 1e-2, 1e4, 0.75, 5);
+  Simulation sim(c);
+  settle(sim);
+  Dynamics& d = sim.dynamics();
+  d.begin_step();
+  Velocities v;
+  ASSERT_TRUE(d.solve(1e-3, v));
+  const ResistanceSystem& rs = d.force_balance().system();
+  const auto n = static_cast<Eigen::Index>(rs.unknowns());
+  // The bordered matrix [[A, b], [b^T, c]] with the wall velocity as one more unknown.
+  std::vector<Eigen::Triplet<double>> trip;
+  const Eigen::SparseMatrix<double> full = rs.matrix().selfadjointView<Eigen::Lower>();
+  for (int col = 0; col < full.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(full, col); it; ++it)
+      trip.emplace_back(it.row(), it.col(), it.value());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (rs.wall_column()[i] == 0.0) continue;
+    trip.emplace_back(i, n, rs.wall_column()[i]);
+    trip.emplace_back(n, i, rs.wall_column()[i]);
+  }
+  trip.emplace_back(n, n, rs.wall_diagonal());
+  Eigen::SparseMatrix<double> bordered(n + 1, n + 1);
+  bordered.setFromTriplets(trip.begin(), trip.end());
+  VecX rhs(n + 1);
+  rhs.head(n) = rs.rhs();
+  rhs[n] = rs.wall_rhs() - d.walls()->load;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(bordered);
+  ASSERT_EQ(lu.info(), Eigen::Success);
+  const VecX x = lu.solve(rhs);
+  ASSERT_GT(rs.wall_column().norm(), 0.0) << "no pair couples the wall: the test would be empty";
+  double umax = 0.0, err = 0.0;
+  for (Eigen::Index i = 0; i < n / 3; ++i)
+    for (int r = 0; r < 3; ++r) {
+      umax = std::max(umax, std::abs(x[3 * i + r]));
+      err = std::max(err, std::abs(x[3 * i + r] - v.u[i][r]));
+    }
+  EXPECT_LT(err, 1e-10 * umax);
+  EXPECT_NEAR(v.wall_v, x[n], 1e-10 * std::max(umax, std::abs(x[n])));
+}
+
+TEST(PressureShear, DilatancyPhiDecreasesWithJ) {
+  // Seed law phi = 0.81 - 0.64 J^1/2: phi(1e-3) - phi(1e-1) ~ 0.18. With N = 100 and a few
+  // strains phi fluctuates by ~0.01-0.02 (phi_std); a margin of 0.05 is > 2.5 sigma of both.
+  Config slow = cell_config(100, 1e-3, 1e4, 0.7, 7);
+  slow.run.strain = 3.0;
+  slow.run.transient_strain = 0.0;
+  slow.steady.window = 1.0;
+  Config fast = slow;
+  fast.flow.j = 1e-1;
+  const auto js_slow = run_summary(slow, "dil_slow");
+  const auto js_fast = run_summary(fast, "dil_fast");
+  const double phi_slow = js_slow["phi"], phi_fast = js_fast["phi"];
+  EXPECT_GT(phi_slow - phi_fast, 0.05) << "phi(1e-3) = " << phi_slow << " phi(1e-1) = " << phi_fast;
+  EXPECT_LT(phi_slow, 0.86);  // below random close packing of the bidisperse discs
+  EXPECT_GT(phi_fast, 0.45);
+}
+
+TEST(PressureShear, SteadyPhiIndependentOfInitialFraction) {
+  Config dilute = cell_config(100, 3e-2, 1e4, 0.55, 11);
+  dilute.run.strain = 5.0;
+  dilute.steady.window = 1.0;
+  dilute.steady.measure_strain = 2.0;
+  Config dense = dilute;
+  dense.particles.phi_init = 0.78;
+  const auto a = run_summary(dilute, "phi_dilute");
+  const auto b = run_summary(dense, "phi_dense");
+  ASSERT_TRUE(a["steady"].get<bool>());
+  ASSERT_TRUE(b["steady"].get<bool>());
+  const double sigma = std::max(a["phi_std"].get<double>(), b["phi_std"].get<double>());
+  // Two independent time averages over 2 strains: allow 3 sigma of the instantaneous spread
+  // (the averages are better than that) plus 0.01 for the residual memory of finite windows.
+  EXPECT_LT(std::abs(a["phi"].get<double>() - b["phi"].get<double>()), 3.0 * sigma + 0.01)
+      << a["phi"] << " vs " << b["phi"];
+}
+
+TEST(PressureShear, WallStaysAboveAndOverlapScalesAsOneOverK) {
+  double max_overlap[2] = {0, 0};
+  const double ks[2] = {1e3, 1e4};
+  for (int q = 0; q < 2; ++q) {
+    Config c = cell_config(100, 1e-2, ks[q], 0.75, 13);
+    Simulation sim(c);
+    const Dynamics& d = sim.dynamics();
+    for (int k = 0; k < 4000 && d.strain() < 1.5; ++k) {
+      sim.step();
+      ASSERT_GT(d.height(), 1.0) << "the top wall came down onto the bottom wall";
+      max_overlap[q] = std::max(max_overlap[q], sim.sample().max_overlap);
+    }
+  }
+  EXPECT_LT(max_overlap[0], 0.05);
+  // Overlap ~ force / kn: a tenfold stiffer contact overlaps ~10x less; forces fluctuate from
+  // run to run, so a factor 3..30 is accepted.
+  const double ratio = max_overlap[0] / max_overlap[1];
+  EXPECT_GT(ratio, 3.0);
+  EXPECT_LT(ratio, 30.0);
+}
+
+TEST(PressureShear, DiscSlabArea) {
+  const double a = 0.7, full = kPi * a * a;
+  EXPECT_NEAR(disc_area_between(0.0, a, -1.0, 1.0), full, 1e-14);
+  EXPECT_NEAR(disc_area_between(0.0, a, 0.0, 1.0), 0.5 * full, 1e-14);
+  EXPECT_NEAR(disc_area_between(0.0, a, 2.0, 3.0), 0.0, 1e-14);
+  // A thin slab through the centre: area ~ 2 a dy.
+  EXPECT_NEAR(disc_area_between(0.0, a, -1e-4, 1e-4), 2.0 * a * 2e-4, 1e-10);
+}
+
+}  // namespace
+}  // namespace sheardiff
