@@ -59,7 +59,8 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
-  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), 3, integrator_->implicit_springs());
+  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), 3, integrator_->implicit_springs(),
+                  cfg.solver.cholesky);
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
                                          lim, std::move(scene.walls));

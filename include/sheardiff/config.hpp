@@ -49,6 +49,9 @@ struct Config {
     double max_strain_step = 1e-2;
     double explicit_safety = 0.5;
   } integrator;
+  struct Solver {
+    std::string cholesky = "cholmod";
+  } solver;
   struct Neighbour {
     double skin = 0.3;
   } neighbour;

@@ -11,10 +11,10 @@ Vec2 pair_vector(const Particles& p, const Box& box, const Pair& pr) {
 }  // namespace
 
 ForceBalance::ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact,
-                           int dof, bool implicit_springs)
+                           int dof, bool implicit_springs, const std::string& cholesky)
     : lubrication_(lubrication),
       contact_(contact),
-      system_(dof),
+      system_(dof, cholesky),
       diagonal_only_(!lubrication && !implicit_springs) {}
 
 void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs) {

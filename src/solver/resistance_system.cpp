@@ -57,8 +57,7 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
       for (int c = 0; c < d; ++c)
         pair_idx_[(k * d + r) * d + c] = index(d * hi + r, d * lo + c);
   }
-  llt_->analyzePattern(a_);
-  pattern_analysed_ = true;
+  llt_->analyze(a_);
   ++analyses_;
 }
 
@@ -118,9 +117,8 @@ bool ResistanceSystem::solve(VecX& u) {
     u = g_.array() / Eigen::Map<const VecX>(diag_.data(), g_.size()).array();
     return u.allFinite();
   }
-  llt_->factorize(a_);
   ++factorisations_;
-  if (llt_->info() != Eigen::Success) return false;
+  if (!llt_->factorize(a_)) return false;
   u = llt_->solve(g_);
   return u.allFinite();
 }
@@ -133,9 +131,8 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
     u = g_.array() / diag;
     u1 = b_.array() / diag;
   } else {
-    llt_->factorize(a_);
     ++factorisations_;
-    if (llt_->info() != Eigen::Success) return false;
+    if (!llt_->factorize(a_)) return false;
     u = llt_->solve(g_);
     u1 = llt_->solve(b_);
   }

@@ -52,7 +52,7 @@ class ForceBalance {
   // implicit_springs: the integrator will pass dt_implicit > 0, so contacts couple particles
   // in the matrix even without lubrication.
   ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact, int dof,
-               bool implicit_springs);
+               bool implicit_springs, const std::string& cholesky = "cholmod");
 
   // The neighbour list changed: new sparsity pattern and symbolic analysis.
   void on_rebuild(const Particles& p, const std::vector<Pair>& pairs);

@@ -1,12 +1,13 @@
 #pragma once
-#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
+#include "sheardiff/solver/sparse_cholesky.hpp"
 
 namespace sheardiff {
 
@@ -18,8 +19,8 @@ namespace sheardiff {
 // list: pairs out of range keep their structural zeros.
 class ResistanceSystem {
  public:
-  explicit ResistanceSystem(int dof = 3)
-      : dof_(dof), llt_(std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>()) {}
+  explicit ResistanceSystem(int dof = 3, const std::string& cholesky = "cholmod")
+      : dof_(dof), llt_(make_sparse_cholesky(cholesky)) {}
 
   int dof() const { return dof_; }
   std::size_t unknowns() const { return static_cast<std::size_t>(dof_) * n_; }
@@ -69,9 +70,7 @@ class ResistanceSystem {
   std::vector<int> diag_idx_;   // dof*dof entries per particle (-1 above the diagonal)
   std::vector<int> pair_idx_;   // dof*dof entries per listed pair, -1 for non mobile-mobile
   std::vector<double> diag_;    // diagonal_only storage
-  // Held by pointer: Eigen's factorisations are not movable.
-  std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>> llt_;
-  bool pattern_analysed_ = false;
+  std::unique_ptr<SparseCholesky> llt_;
   std::size_t factorisations_ = 0, analyses_ = 0;
 };
 

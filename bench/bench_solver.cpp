@@ -1,0 +1,100 @@
+// Solver choice for the per-step SPD system (issue "fast and accurate"): factorise the matrix of
+// a dense sheared packing (simple shear, phi = 0.77, ktilde = 1e4, implicit springs) with each
+// candidate. Prints time per factorisation + solve; the symbolic analysis is done once, as in a
+// run between neighbour rebuilds.
+//
+//   build/bench/bench_solver --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <map>
+#include <memory>
+
+#ifdef SHEARDIFF_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#endif
+
+#include "sheardiff/simulation.hpp"
+
+namespace {
+
+struct Problem {
+  Eigen::SparseMatrix<double> lower;  // lower triangle, as assembled
+  Eigen::SparseMatrix<double> full;
+  Eigen::VectorXd rhs;
+};
+
+const Problem& problem(int n) {
+  static std::map<int, Problem> cache;
+  auto it = cache.find(n);
+  if (it != cache.end()) return it->second;
+  sheardiff::Config cfg;
+  cfg.particles.n = n;
+  cfg.particles.phi_init = 0.77;
+  cfg.flow.j = 1e-2;
+  cfg.contact.ktilde = 1e4;
+  sheardiff::Simulation sim(cfg);
+  for (int k = 0; k < 30; ++k) sim.step();
+  Problem p;
+  const auto& rs = sim.dynamics().force_balance().system();
+  p.lower = rs.matrix();
+  p.full = p.lower.selfadjointView<Eigen::Lower>();
+  p.rhs = rs.rhs();
+  return cache.emplace(n, std::move(p)).first->second;
+}
+
+template <class Solver>
+void factorise(benchmark::State& state) {
+  const Problem& p = problem(static_cast<int>(state.range(0)));
+  Solver solver;
+  solver.analyzePattern(p.lower);
+  Eigen::VectorXd x;
+  for (auto _ : state) {
+    solver.factorize(p.lower);
+    x = solver.solve(p.rhs);
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["unknowns"] = static_cast<double>(p.lower.rows());
+  state.counters["nnz_lower"] = static_cast<double>(p.lower.nonZeros());
+  state.counters["rel_residual"] = (p.full * x - p.rhs).norm() / p.rhs.norm();
+}
+
+using LLT = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+using LDLT = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+BENCHMARK(factorise<LLT>)->Name("eigen_simplicial_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(factorise<LDLT>)->Name("eigen_simplicial_ldlt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+#ifdef SHEARDIFF_HAVE_CHOLMOD
+using Supernodal = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+using CholSimplicial = Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+BENCHMARK(factorise<Supernodal>)->Name("cholmod_supernodal_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(factorise<CholSimplicial>)->Name("cholmod_simplicial_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+#endif
+
+// Conjugate gradient warm-started from the exact solution perturbed by 1% (what a previous
+// step's velocities give), to the relative tolerance 1e-10.
+template <class Preconditioner>
+void conjugate_gradient(benchmark::State& state) {
+  const Problem& p = problem(static_cast<int>(state.range(0)));
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Preconditioner> cg;
+  cg.setTolerance(1e-10);
+  cg.compute(p.full);
+  LLT exact(p.lower);
+  const Eigen::VectorXd x_exact = exact.solve(p.rhs);
+  const Eigen::VectorXd guess = x_exact + 0.01 * x_exact.cwiseAbs().maxCoeff() *
+                                              Eigen::VectorXd::Random(x_exact.size());
+  Eigen::VectorXd x;
+  for (auto _ : state) {
+    cg.compute(p.full);
+    x = cg.solveWithGuess(p.rhs, guess);
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["iterations"] = static_cast<double>(cg.iterations());
+  state.counters["rel_residual"] = (p.full * x - p.rhs).norm() / p.rhs.norm();
+}
+BENCHMARK(conjugate_gradient<Eigen::DiagonalPreconditioner<double>>)->Name("cg_jacobi_warm")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(conjugate_gradient<Eigen::IncompleteCholesky<double>>)->Name("cg_ichol_warm")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,24 @@
+#pragma once
+#include <Eigen/SparseCore>
+#include <memory>
+#include <string>
+
+namespace sheardiff {
+
+// A sparse Cholesky factorisation of the lower triangle of an SPD matrix, with the symbolic
+// analysis kept between factorisations of matrices of the same pattern.
+class SparseCholesky {
+ public:
+  virtual ~SparseCholesky() = default;
+  virtual void analyze(const Eigen::SparseMatrix<double>& lower) = 0;
+  // False if the matrix is not positive definite.
+  virtual bool factorize(const Eigen::SparseMatrix<double>& lower) = 0;
+  virtual Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const = 0;
+  virtual const char* name() const = 0;
+};
+
+// "cholmod": CHOLMOD supernodal LLT (SuiteSparse; fastest, see docs/performance.md);
+// "eigen": Eigen's SimplicialLLT.
+std::unique_ptr<SparseCholesky> make_sparse_cholesky(const std::string& kind);
+
+}  // namespace sheardiff
