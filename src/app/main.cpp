@@ -50,11 +50,30 @@ int main(int argc, char** argv) {
       return 0;
     }
     const auto summary = sheardiff::run_to_directory(cfg, out_dir, true);
-    fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s; shear stress {:.5g}, pressure {:.5g}, "
-               "max overlap {:.3g}\n",
+    fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
                out_dir, summary["strain"].get<double>(), summary["steps"].get<long>(),
-               summary["wall_seconds"].get<double>(), summary["shear_stress"].get<double>(),
-               summary["pressure"].get<double>(), summary["max_overlap"].get<double>());
+               summary["wall_seconds"].get<double>(), summary["ms_per_step"].get<double>(),
+               summary["max_overlap"].get<double>());
+    if (summary.contains("steady")) {
+      if (!summary["steady"].get<bool>()) {
+        fmt::print("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
+                   summary["phi"].get<double>());
+      } else {
+        fmt::print("  steady from strain {:.3g}: phi = {:.4f} +- {:.4f}, mu = {:.4f}, H = {:.3f} d\n",
+                   summary["steady_strain"].get<double>(), summary["phi"].get<double>(),
+                   summary["phi_std"].get<double>(), summary["mu"].get<double>(),
+                   summary["H"].get<double>());
+        fmt::print("  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
+                   "held steps)\n",
+                   summary["pressure_measured"].get<double>(),
+                   summary["pressure_max_relative_error"].get<double>(),
+                   summary["steps"].get<long>() - summary["wall_free_fall_steps"].get<long>());
+      }
+    } else {
+      fmt::print("  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
+                 summary["shear_stress"].get<double>(), summary["pressure"].get<double>(),
+                 summary["viscosity"].get<double>());
+    }
     return 0;
   } catch (const sheardiff::ConfigError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
