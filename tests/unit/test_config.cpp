@@ -1,0 +1,318 @@
+// The run configuration (src/config.cpp): defaults, round trip through TOML, and errors that
+// name the origin, the key and the allowed range.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sheardiff/config.hpp"
+
+namespace sheardiff {
+namespace {
+
+// Every field of two configurations, compared exactly (a round trip must not lose a bit).
+void expect_same_config(const Config& a, const Config& b) {
+  EXPECT_EQ(a.scene.type, b.scene.type);
+  EXPECT_EQ(a.particles.n, b.particles.n);
+  EXPECT_EQ(a.particles.mix, b.particles.mix);
+  EXPECT_EQ(a.particles.size_ratio, b.particles.size_ratio);
+  EXPECT_EQ(a.particles.phi_init, b.particles.phi_init);
+  EXPECT_EQ(a.particles.aspect, b.particles.aspect);
+  EXPECT_EQ(a.particles.init_file, b.particles.init_file);
+  EXPECT_EQ(a.particles.init_frame, b.particles.init_frame);
+  EXPECT_EQ(a.flow.j, b.flow.j);
+  EXPECT_EQ(a.flow.lz, b.flow.lz);
+  EXPECT_EQ(a.lubrication.enabled, b.lubrication.enabled);
+  EXPECT_EQ(a.lubrication.delta, b.lubrication.delta);
+  EXPECT_EQ(a.lubrication.h_max, b.lubrication.h_max);
+  EXPECT_EQ(a.contact.ktilde, b.contact.ktilde);
+  EXPECT_EQ(a.contact.kt_ratio, b.contact.kt_ratio);
+  EXPECT_EQ(a.contact.mu, b.contact.mu);
+  EXPECT_EQ(a.integrator.type, b.integrator.type);
+  EXPECT_EQ(a.integrator.dt, b.integrator.dt);
+  EXPECT_EQ(a.integrator.max_displacement, b.integrator.max_displacement);
+  EXPECT_EQ(a.integrator.max_gap_fraction, b.integrator.max_gap_fraction);
+  EXPECT_EQ(a.integrator.max_overlap_change, b.integrator.max_overlap_change);
+  EXPECT_EQ(a.integrator.max_strain_step, b.integrator.max_strain_step);
+  EXPECT_EQ(a.integrator.explicit_safety, b.integrator.explicit_safety);
+  EXPECT_EQ(a.neighbour.skin, b.neighbour.skin);
+  EXPECT_EQ(a.run.strain, b.run.strain);
+  EXPECT_EQ(a.run.seed, b.run.seed);
+  EXPECT_EQ(a.run.max_steps, b.run.max_steps);
+  EXPECT_EQ(a.run.transient_strain, b.run.transient_strain);
+  EXPECT_EQ(a.walls.free_fall_speed, b.walls.free_fall_speed);
+  EXPECT_EQ(a.walls.jitter, b.walls.jitter);
+  EXPECT_EQ(a.steady.window, b.steady.window);
+  EXPECT_EQ(a.steady.h_tolerance, b.steady.h_tolerance);
+  EXPECT_EQ(a.steady.mu_tolerance, b.steady.mu_tolerance);
+  EXPECT_EQ(a.steady.measure_strain, b.steady.measure_strain);
+  EXPECT_EQ(a.observables.wall_exclusion, b.observables.wall_exclusion);
+  EXPECT_EQ(a.observables.profile_bin, b.observables.profile_bin);
+  EXPECT_EQ(a.output.frame_strain, b.output.frame_strain);
+  EXPECT_EQ(a.output.velocities, b.output.velocities);
+  EXPECT_EQ(a.output.trajectory, b.output.trajectory);
+}
+
+// The message of the ConfigError thrown by parse_config, or "" (and a failure) if none is.
+std::string config_error(const std::string& toml, const std::vector<std::string>& overrides = {},
+                         const std::string& origin = "test.toml") {
+  try {
+    parse_config(toml, origin, overrides);
+  } catch (const ConfigError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected ConfigError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected ConfigError for:\n" << toml;
+  return "";
+}
+
+#define EXPECT_CONTAINS(text, piece) \
+  EXPECT_NE(std::string(text).find(piece), std::string::npos) << "message: " << (text)
+
+TEST(Config, EmptyDocumentGivesTheDefaults) {
+  const Config def;
+  const Config cfg = parse_config("", "empty.toml");
+  expect_same_config(cfg, def);
+  // The documented defaults (model.md section 10 and docs/config.md).
+  EXPECT_EQ(cfg.scene.type, "simple_shear");
+  EXPECT_EQ(cfg.particles.n, 500);
+  EXPECT_EQ(cfg.particles.mix, MixRule::Area);
+  EXPECT_EQ(cfg.particles.size_ratio, 1.4);
+  EXPECT_EQ(cfg.flow.j, 1e-2);
+  EXPECT_EQ(cfg.flow.lz, 1.0);
+  EXPECT_TRUE(cfg.lubrication.enabled);
+  EXPECT_EQ(cfg.lubrication.delta, 0.01);
+  EXPECT_EQ(cfg.lubrication.h_max, 0.5);
+  EXPECT_EQ(cfg.contact.ktilde, 1e4);
+  EXPECT_EQ(cfg.contact.kt_ratio, 0.5);
+  EXPECT_EQ(cfg.contact.mu, 0.5);
+  EXPECT_EQ(cfg.integrator.type, IntegratorType::Implicit);
+  EXPECT_EQ(cfg.integrator.max_displacement, 1e-3);
+}
+
+TEST(Config, MinimalDocumentSetsValuesAndKeepsDefaults) {
+  const std::string toml = R"(
+[particles]
+N = 120
+mix = "volume"
+
+[flow]
+J = 3e-4
+
+[contact]
+ktilde = 100      # an integer is accepted for a real key
+mu = 0.0
+
+[integrator]
+type = "heun"
+
+[lubrication]
+enabled = false
+)";
+  const Config cfg = parse_config(toml, "min.toml");
+  EXPECT_EQ(cfg.particles.n, 120);
+  EXPECT_EQ(cfg.particles.mix, MixRule::Volume);
+  EXPECT_EQ(cfg.flow.j, 3e-4);
+  EXPECT_EQ(cfg.contact.ktilde, 100.0);
+  EXPECT_EQ(cfg.contact.mu, 0.0);
+  EXPECT_EQ(cfg.integrator.type, IntegratorType::Heun);
+  EXPECT_FALSE(cfg.lubrication.enabled);
+  // Everything not set keeps its default.
+  Config want;
+  want.particles.n = 120;
+  want.particles.mix = MixRule::Volume;
+  want.flow.j = 3e-4;
+  want.contact.ktilde = 100.0;
+  want.contact.mu = 0.0;
+  want.integrator.type = IntegratorType::Heun;
+  want.lubrication.enabled = false;
+  expect_same_config(cfg, want);
+}
+
+TEST(Config, ToTomlRoundTrips) {
+  // Defaults, and a configuration with values that need all 17 significant digits.
+  expect_same_config(parse_config(to_toml(Config{}), "resolved.toml"), Config{});
+
+  Config c;
+  c.scene.type = "pressure_shear";
+  c.particles.n = 777;
+  c.particles.mix = MixRule::Number;
+  c.particles.size_ratio = 1.3;
+  c.particles.phi_init = 0.1 + 0.2;  // 0.30000000000000004
+  c.particles.aspect = 2.5;
+  c.particles.init_file = "runs/start frame.h5";
+  c.particles.init_frame = 12;
+  c.flow.j = 1.0 / 3.0 * 1e-3;
+  c.flow.lz = 0.5;
+  c.lubrication.enabled = false;
+  c.lubrication.delta = 0.02;
+  c.lubrication.h_max = 0.4;
+  c.contact.ktilde = 123456.789;
+  c.contact.kt_ratio = 2.0 / 7.0;
+  c.contact.mu = 1.0;
+  c.integrator.type = IntegratorType::Euler;
+  c.integrator.dt = 1e-3;
+  c.integrator.max_displacement = 2e-3;
+  c.integrator.max_gap_fraction = 0.25;
+  c.integrator.max_overlap_change = 5e-4;
+  c.integrator.max_strain_step = 3e-3;
+  c.integrator.explicit_safety = 0.7;
+  c.neighbour.skin = 0.45;
+  c.run.strain = 20.0;
+  c.run.seed = 4242424242424242;
+  c.run.max_steps = 1000000;
+  c.run.transient_strain = 5.0;
+  c.walls.free_fall_speed = 0.1;
+  c.walls.jitter = 0.0;
+  c.steady.window = 3.0;
+  c.steady.h_tolerance = 0.02;
+  c.steady.mu_tolerance = 0.1;
+  c.steady.measure_strain = 4.0;
+  c.observables.wall_exclusion = 2.0;
+  c.observables.profile_bin = 0.25;
+  c.output.frame_strain = 0.02;
+  c.output.velocities = false;
+  c.output.trajectory = false;
+  const std::string text = to_toml(c);
+  const Config back = parse_config(text, "resolved.toml");
+  SCOPED_TRACE(text);
+  expect_same_config(back, c);
+  // Idempotent: printing the parsed copy gives the same text.
+  EXPECT_EQ(to_toml(back), text);
+}
+
+TEST(Config, UnknownKeySuggestsTheNearMiss) {
+  const std::string msg = config_error("[flow]\nj = 1e-3\n", {}, "runs/a.toml");
+  EXPECT_CONTAINS(msg, "runs/a.toml");
+  EXPECT_CONTAINS(msg, "flow.j");
+  EXPECT_CONTAINS(msg, "unknown key");
+  EXPECT_CONTAINS(msg, "did you mean 'flow.J'");
+  // A key far from every known one gets no suggestion.
+  const std::string far = config_error("[flow]\nzzzzzzzzzz = 1\n");
+  EXPECT_CONTAINS(far, "flow.zzzzzzzzzz");
+  EXPECT_CONTAINS(far, "unknown key");
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+  // Unknown section, and a top-level key outside any section.
+  EXPECT_CONTAINS(config_error("[contacts]\nmu = 0.3\n"), "contacts.mu");
+  EXPECT_CONTAINS(config_error("seed = 3\n"), "seed");
+}
+
+TEST(Config, OutOfRangeValuesNameKeyAndRange) {
+  // flow.J lives in (0, 10]: 0 itself is excluded.
+  const std::string j0 = config_error("[flow]\nJ = 0\n");
+  EXPECT_CONTAINS(j0, "test.toml");
+  EXPECT_CONTAINS(j0, "flow.J");
+  EXPECT_CONTAINS(j0, "(0, 10]");
+  EXPECT_CONTAINS(config_error("[flow]\nJ = 10.5\n"), "(0, 10]");
+  // The boundaries themselves are accepted where closed.
+  EXPECT_EQ(parse_config("[flow]\nJ = 10\n", "t").flow.j, 10.0);
+  // particles.N is an integer in [2, 1e6].
+  const std::string nn = config_error("[particles]\nN = -5\n");
+  EXPECT_CONTAINS(nn, "particles.N");
+  EXPECT_CONTAINS(nn, "-5");
+  EXPECT_CONTAINS(nn, "[2, 1e+06]");
+  EXPECT_CONTAINS(config_error("[particles]\nN = 1\n"), "particles.N");
+  // lubrication.h_max must stay below 1 (model.md section 10) and above 0.
+  EXPECT_CONTAINS(config_error("[lubrication]\nh_max = 1.5\n"), "lubrication.h_max");
+  EXPECT_CONTAINS(config_error("[lubrication]\ndelta = 0.0\n"), "lubrication.delta");
+  // Non-finite reals are rejected.
+  EXPECT_CONTAINS(config_error("[contact]\nktilde = inf\n"), "contact.ktilde");
+  EXPECT_CONTAINS(config_error("[contact]\nktilde = nan\n"), "contact.ktilde");
+}
+
+TEST(Config, WrongTypeNamesKeyAndExpectedType) {
+  const std::string msg = config_error("[contact]\nktilde = \"stiff\"\n");
+  EXPECT_CONTAINS(msg, "contact.ktilde");
+  EXPECT_CONTAINS(msg, "\"stiff\"");
+  EXPECT_CONTAINS(msg, "a number in [1, 1e+09]");
+  // A real where an integer is required, and a number where a bool is.
+  const std::string nreal = config_error("[particles]\nN = 100.5\n");
+  EXPECT_CONTAINS(nreal, "particles.N");
+  EXPECT_CONTAINS(nreal, "an integer");
+  EXPECT_CONTAINS(config_error("[output]\nvelocities = 1\n"), "true or false");
+  // A section that is not a table.
+  EXPECT_CONTAINS(config_error("flow = 3\n"), "flow");
+}
+
+TEST(Config, BadEnumValueListsTheChoices) {
+  const std::string msg = config_error("[integrator]\ntype = \"rk4\"\n");
+  EXPECT_CONTAINS(msg, "integrator.type");
+  EXPECT_CONTAINS(msg, "\"rk4\"");
+  EXPECT_CONTAINS(msg, "one of \"implicit\" \"euler\" \"heun\"");
+  EXPECT_CONTAINS(config_error("[particles]\nmix = \"mass\"\n"), "\"area\" \"volume\" \"number\"");
+  EXPECT_CONTAINS(config_error("[scene]\ntype = \"couette\"\n"), "scene.type");
+}
+
+TEST(Config, NotTomlNamesOriginAndLine) {
+  // The error is on line 3 (an unterminated table header).
+  const std::string msg = config_error("[flow]\nJ = 1e-3\n[contact\nmu = 0.2\n", {}, "bad.toml");
+  EXPECT_CONTAINS(msg, "bad.toml:3:");
+  EXPECT_CONTAINS(msg, "not valid TOML");
+  // A duplicated key is also a TOML error, reported on the line of the duplicate (3).
+  EXPECT_CONTAINS(config_error("[flow]\nJ = 1\nJ = 2\n", {}, "dup.toml"), "dup.toml:3:");
+}
+
+TEST(Config, SetOverridesAreAppliedAndValidated) {
+  const std::string base = "[flow]\nJ = 1e-2\n";
+  const Config cfg = parse_config(base, "base.toml",
+                                  {"flow.J=1e-3", "integrator.type=heun", "particles.N=64",
+                                   "lubrication.enabled=false", "scene.type=\"pressure_shear\""});
+  EXPECT_EQ(cfg.flow.j, 1e-3);
+  EXPECT_EQ(cfg.integrator.type, IntegratorType::Heun);  // bare word taken as a string
+  EXPECT_EQ(cfg.particles.n, 64);
+  EXPECT_FALSE(cfg.lubrication.enabled);
+  EXPECT_EQ(cfg.scene.type, "pressure_shear");
+  // Later overrides win.
+  EXPECT_EQ(parse_config(base, "b", {"flow.J=0.5", "flow.J=0.25"}).flow.j, 0.25);
+
+  const std::string abc = config_error(base, {"flow.J=abc"});
+  EXPECT_CONTAINS(abc, "--set");
+  EXPECT_CONTAINS(abc, "flow.J");
+  EXPECT_CONTAINS(abc, "abc");
+  EXPECT_CONTAINS(abc, "(0, 10]");
+  const std::string range = config_error(base, {"flow.J=0"});
+  EXPECT_CONTAINS(range, "flow.J");
+  EXPECT_CONTAINS(range, "(0, 10]");
+  const std::string unknown = config_error(base, {"flow.j=1e-3"});
+  EXPECT_CONTAINS(unknown, "--set");
+  EXPECT_CONTAINS(unknown, "unknown key");
+  EXPECT_CONTAINS(unknown, "did you mean 'flow.J'");
+  const std::string shape = config_error(base, {"flowJ"});
+  EXPECT_CONTAINS(shape, "section.key=value");
+}
+
+TEST(Config, TransientMustEndBeforeTheRun) {
+  const std::string msg = config_error("[run]\nstrain = 2.0\ntransient_strain = 3.0\n");
+  EXPECT_CONTAINS(msg, "run.transient_strain");
+  EXPECT_CONTAINS(msg, "run.strain");
+  // Equal is rejected too (nothing would be averaged).
+  EXPECT_CONTAINS(config_error("[run]\nstrain = 2.0\ntransient_strain = 2.0\n"),
+                  "run.transient_strain");
+  // The check also sees values from --set.
+  EXPECT_CONTAINS(config_error("[run]\nstrain = 2.0\n", {"run.transient_strain=2.5"}),
+                  "run.transient_strain");
+  // Smaller is fine.
+  EXPECT_EQ(parse_config("[run]\nstrain = 2.0\ntransient_strain = 1.5\n", "t").run.transient_strain,
+            1.5);
+}
+
+TEST(Config, OtherCombinationChecks) {
+  EXPECT_CONTAINS(config_error("[particles]\nphi_init = 0.88\n"), "particles.phi_init");
+  EXPECT_CONTAINS(config_error("[run]\nstrain = 0.5\n[output]\nframe_strain = 0.6\n"),
+                  "output.frame_strain");
+}
+
+TEST(Config, ReferenceTableListsEveryKey) {
+  const std::string md = config_reference_markdown();
+  for (const char* key : {"`scene.type`", "`particles.N`", "`flow.J`", "`contact.ktilde`",
+                          "`integrator.type`", "`run.transient_strain`", "`output.trajectory`"})
+    EXPECT_CONTAINS(md, key);
+  EXPECT_STREQ(to_string(IntegratorType::Implicit), "implicit");
+  EXPECT_STREQ(to_string(MixRule::Volume), "volume");
+}
+
+}  // namespace
+}  // namespace sheardiff
