@@ -30,19 +30,10 @@ void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vect
   }
 }
 
-bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
-                         const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
-                         Velocities& out) {
-  if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
-  if (dt_implicit > 0.0 && diagonal_only_)
-    throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
-  system_.clear();
-  for (std::size_t i = 0; i < p.n_mobile; ++i) {
-    const Vec3 drag = StokesDrag::resistance(p.radius[i]);
-    Vec3 force = drag.cwiseProduct(flow.velocity(p.position[i]));
-    if (!p.external.empty()) force += p.external[i];
-    system_.add_self(static_cast<int>(i), drag, force);
-  }
+template <bool kWalls>
+void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
+                                  const std::vector<Pair>& pairs, double dt_implicit,
+                                  const WallDrive* wall) {
   const bool friction = contact_.has_friction();
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
@@ -61,14 +52,38 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
       term.sliding = friction && contact_.at_coulomb_limit(term.g, pr.contact.xi);
       if (dt_implicit > 0.0) term.m += dt_implicit * contact_.stiffness(term.g, term.sliding);
     }
-    const Motion mj = p.motion[pr.j];
     term.image_j = Vec3::Zero();
     Vec3 known = Vec3::Zero();
-    if (mj == Motion::Mobile) known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
-    else if (mj == Motion::FloatingWall && wall) known.x() = wall->vx;
-    system_.add_pair(k, pr, term.m, term.f, known, mj == Motion::Mobile,
-                     mj == Motion::FloatingWall && wall);
+    if constexpr (kWalls) {
+      const Motion mj = p.motion[pr.j];
+      if (mj == Motion::Mobile) known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
+      else if (mj == Motion::FloatingWall) known.x() = wall->vx;
+      system_.add_pair(k, pr, term.m, term.f, known, mj == Motion::Mobile,
+                       mj == Motion::FloatingWall);
+    } else {
+      known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
+      system_.add_pair(k, pr, term.m, term.f, known, true, false);
+    }
   }
+
+}
+
+bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
+                         const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
+                         Velocities& out) {
+  if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
+  if (dt_implicit > 0.0 && diagonal_only_)
+    throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
+  system_.clear();
+  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+    const Vec3 drag = StokesDrag::resistance(p.radius[i]);
+    Vec3 force = drag.cwiseProduct(flow.velocity(p.position[i]));
+    if (!p.external.empty()) force += p.external[i];
+    system_.add_self(static_cast<int>(i), drag, force);
+  }
+  // Scenes without walls get a loop with no wall branch at all.
+  if (wall) assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
+  else assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
 
   double v = 0.0;
   bool capped = false;

@@ -74,6 +74,10 @@ class ForceBalance {
   void set_check_residual(bool on) { check_residual_ = on; }
 
  private:
+  template <bool kWalls>
+  void assemble_pairs(const Particles& p, const Box& box, const std::vector<Pair>& pairs,
+                      double dt_implicit, const WallDrive* wall);
+
   std::optional<Lubrication> lubrication_;
   FrictionalContact contact_;
   ResistanceSystem system_;
