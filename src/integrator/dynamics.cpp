@@ -84,18 +84,23 @@ double Dynamics::dt_limit(const Velocities& v) const {
 }
 
 void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
-  // Springs first: they stretch with the slip at the geometry of the start of the step.
+  // Springs stretch with the slip at the geometry of the start of the step (recomputed here:
+  // after a Heun corrector the pair terms hold the predicted geometry) ...
   const FrictionalContact& law = force_balance_.contact();
-  if (law.has_friction()) {
-    auto& pairs = neighbours_.pairs();
-    const auto& terms = force_balance_.terms();
-    for (std::size_t k = 0; k < pairs.size(); ++k) {
-      Pair& pr = pairs[k];
+  const bool friction = law.has_friction();
+  auto& pairs = neighbours_.pairs();
+  const auto pair_geometry = [&](const Pair& pr) {
+    const Vec2 rij = particles_.position[pr.j] + box_.image_shift(pr.kx, pr.ky) -
+                     particles_.position[pr.i];
+    return PairGeometry::make(rij, particles_.radius[pr.i], particles_.radius[pr.j]);
+  };
+  if (friction) {
+    for (Pair& pr : pairs) {
       if (!pr.contact.active) continue;
       Vec6 u;
-      u << v.u[pr.i], v.u[pr.j] + terms[k].image_j;
-      pr.contact.xi += FrictionalContact::slip_rate(terms[k].g, u) * dt;
-      law.apply_coulomb(terms[k].g, pr.contact.xi);
+      u << v.u[pr.i], v.u[pr.j];
+      if (particles_.motion[pr.j] == Motion::Mobile) u[3] += box_.image_velocity_x(pr.ky);
+      pr.contact.xi += FrictionalContact::slip_rate(pair_geometry(pr), u) * dt;
     }
   }
   na_.resize(particles_.size());
@@ -111,6 +116,12 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
     particles_.velocity[i] = v.u[i];
   }
   if (box_.lees_edwards) box_.le_offset += flow_.gammadot * box_.ly * dt;
+  // ... and are capped by Coulomb at the end of the step, where their force is next evaluated,
+  // so kt |xi| <= mu kn overlap holds at every force evaluation.
+  if (friction) {
+    for (Pair& pr : pairs)
+      if (pr.contact.active) pr.contact.sliding = law.apply_coulomb(pair_geometry(pr), pr.contact.xi);
+  }
   time_ += dt;
   neighbours_.advance(na_, flow_.gammadot * dt);
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;

@@ -26,7 +26,7 @@ void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vect
   for (Pair& pr : pairs) {
     const double r = pair_vector(p, box, pr).norm();
     const bool touching = r <= p.radius[pr.i] + p.radius[pr.j];
-    if (touching != pr.contact.active) pr.contact = ContactHistory{touching, 0.0};
+    if (touching != pr.contact.active) pr.contact = ContactHistory{touching, 0.0, false};
   }
 }
 
@@ -49,7 +49,9 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
       term.m = lubrication_->coefficients(term.g.ai, term.g.aj, term.g.h).matrix(term.g.n, term.g.t);
     if (contact) {
       term.f = contact_.spring_force(term.g, friction ? pr.contact.xi : 0.0);
-      term.sliding = friction && contact_.at_coulomb_limit(term.g, pr.contact.xi);
+      // Sliding is what the last Coulomb cap decided, not a re-test of |xi| against the new
+      // overlap: a growing overlap would otherwise turn a sliding contact sticky.
+      term.sliding = friction && pr.contact.sliding;
       if (dt_implicit > 0.0) term.m += dt_implicit * contact_.stiffness(term.g, term.sliding);
     }
     term.image_j = Vec3::Zero();

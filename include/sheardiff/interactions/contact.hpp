@@ -7,6 +7,7 @@ namespace sheardiff {
 struct ContactHistory {
   bool active = false;  // h <= 0 at the start of the current step
   double xi = 0.0;      // scalar tangential spring stretch (2D)
+  bool sliding = false; // the last step capped xi at the Coulomb limit
 };
 
 // Linear spring contact with Coulomb friction (model.md section 5). Forces act in the
