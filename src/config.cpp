@@ -214,8 +214,22 @@ const std::vector<KeySpec>& schema() {
                      "pressure_shear: slab next to each wall left out of the bulk phi."));
     s.push_back(real("observables.profile_bin", &C::observables, &C::Observables::profile_bin, 0.0,
                      100.0, true, "d", "Bin width of the phi, u_x and T profiles across the gap."));
-    s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, true,
-                     "1 (strain)", "Strain between two trajectory frames."));
+    s.push_back(boolean("analysis.diffusion", &C::analysis, &C::Analysis::diffusion,
+                        "Self-diffusion analysis over the measured window (steady state, or "
+                        "after run.transient_strain): MSD, D, dv, VACF, Psi; writes "
+                        "DIR/analysis.h5. Off = it costs nothing."));
+    s.push_back(real("analysis.msd_window_lo", &C::analysis, &C::Analysis::msd_window_lo, 0.0,
+                     1e5, false, "1 (strain)", "Start of the MSD fit window (seed: 8)."));
+    s.push_back(real("analysis.msd_window_hi", &C::analysis, &C::Analysis::msd_window_hi, 0.0,
+                     1e5, true, "1 (strain)", "End of the MSD fit window (seed: 15)."));
+    s.push_back(integer("analysis.reference_times", &C::analysis, &C::Analysis::reference_times, 1,
+                        1e8, "", "Reference times t0 of the MSD, drawn in the measured window."));
+    s.push_back(real("analysis.vacf_max_lag", &C::analysis, &C::Analysis::vacf_max_lag, 0.0, 1e3,
+                     true, "1 (strain)", "Longest lag of the velocity autocorrelation."));
+    s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, false,
+                     "1 (strain)",
+                     "Strain between two trajectory frames; 0 = 0.035 J^(1/4), i.e. 10 frames per "
+                     "persistence time Psi gammadot = 0.35 J^(1/4) (seed eq. 3.6b)."));
     s.push_back(boolean("output.velocities", &C::output, &C::Output::velocities,
                         "Write velocities and angular velocities to the trajectory."));
     s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
@@ -338,7 +352,15 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
   }
 }
 
+void resolve_defaults(Config& c) {
+  if (c.output.frame_strain == 0.0) c.output.frame_strain = 0.035 * std::pow(c.flow.j, 0.25);
+}
+
 void check_combinations(const Config& c, const std::string& origin) {
+  if (c.analysis.msd_window_lo >= c.analysis.msd_window_hi)
+    fail(origin, "analysis.msd_window_lo",
+         fmt::format("{:g} must be below analysis.msd_window_hi = {:g}", c.analysis.msd_window_lo,
+                     c.analysis.msd_window_hi));
   if (c.particles.init_file.empty() && c.particles.phi_init > 0.86)
     fail(origin, "particles.phi_init",
          fmt::format("random placement with compression cannot reach {:g}; allowed up to 0.86 "
@@ -391,6 +413,7 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
     }
     spec->set(cfg, convert(*t.get("v"), *spec, "--set"));
   }
+  resolve_defaults(cfg);
   check_combinations(cfg, origin);
   return cfg;
 }

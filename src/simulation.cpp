@@ -12,6 +12,8 @@
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/observe/diffusion_observer.hpp"
+#include <functional>
 
 namespace sheardiff {
 
@@ -88,10 +90,23 @@ void write_text_atomically(const std::filesystem::path& file, const std::string&
 
 }  // namespace
 
-std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg) {
+// Only the observers the scene and the config ask for are composed into the run.
+std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
+                                                      const std::filesystem::path& out_dir) {
   std::vector<std::unique_ptr<Observer>> obs;
   obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  if (cfg.scene.type == "pressure_shear") obs.push_back(std::make_unique<PressureCellObserver>(cfg));
+  std::function<bool(const Dynamics&)> measuring;
+  if (cfg.scene.type == "pressure_shear") {
+    auto cell = std::make_unique<PressureCellObserver>(cfg);
+    const PressureCellObserver* c = cell.get();
+    measuring = [c](const Dynamics&) { return c->steady(); };
+    obs.push_back(std::move(cell));
+  } else {
+    const double from = cfg.run.transient_strain;
+    measuring = [from](const Dynamics& d) { return d.strain() > from; };
+  }
+  if (cfg.analysis.diffusion)
+    obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / "analysis.h5", measuring));
   return obs;
 }
 
@@ -104,7 +119,7 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   Simulation sim(cfg);
   Dynamics& d = sim.dynamics();
   const Particles& p = d.particles();
-  auto observers = make_observers(cfg);
+  auto observers = make_observers(cfg, out_dir);
 
   std::vector<std::string> names;
   for (const auto& o : observers)
@@ -128,7 +143,7 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
 
   const bool tty = progress && isatty(fileno(stderr));
   const auto t0 = std::chrono::steady_clock::now();
-  auto last_print = t0;
+  auto last_print = t0, last_flush = t0;
   double next_frame = cfg.output.frame_strain;
   std::vector<double> values;
   const auto finished = [&] {
@@ -159,15 +174,21 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
         writer->write_frame(f);
       }
     }
-    if (tty) {
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last_print > std::chrono::milliseconds(500)) {
-        last_print = now;
-        const double el = std::chrono::duration<double>(now - t0).count();
-        const double eta = el * (cfg.run.strain - d.strain()) / std::max(d.strain(), 1e-12);
-        std::fprintf(stderr, "\rstrain %.4g / %.4g  steps %ld  %.0f steps/s  ETA %.0f s   ",
-                     d.strain(), cfg.run.strain, d.steps(), d.steps() / el, eta);
-      }
+    const auto now = std::chrono::steady_clock::now();
+    // A terminal gets a live line; a batch log gets one line a minute. The trajectory is
+    // flushed every half minute so that a killed run leaves readable frames behind.
+    const auto since = now - last_print;
+    if ((tty && since > std::chrono::milliseconds(500)) || (!tty && progress && since > std::chrono::seconds(60))) {
+      last_print = now;
+      const double el = std::chrono::duration<double>(now - t0).count();
+      const double eta = el * (cfg.run.strain - d.strain()) / std::max(d.strain(), 1e-12);
+      std::fprintf(stderr, "%sstrain %.4g / %.4g  steps %ld  %.0f steps/s  ETA %.0f s%s",
+                   tty ? "\r" : "", d.strain(), cfg.run.strain, d.steps(), d.steps() / el, eta,
+                   tty ? "   " : "\n");
+    }
+    if (writer && now - last_flush > std::chrono::seconds(30)) {
+      writer->flush();
+      last_flush = now;
     }
   }
   if (tty) std::fprintf(stderr, "\n");

@@ -75,8 +75,15 @@ struct Config {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi
     double profile_bin = 0.5;     // d, bin width of the profiles across the gap
   } observables;
+  struct Analysis {
+    bool diffusion = true;         // MSD, VACF, dv, Psi, D over the measured window
+    double msd_window_lo = 8.0;    // strain
+    double msd_window_hi = 15.0;   // strain
+    std::int64_t reference_times = 1000;
+    double vacf_max_lag = 2.0;     // strain
+  } analysis;
   struct Output {
-    double frame_strain = 0.01;
+    double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi
     bool velocities = true;
     bool trajectory = true;
   } output;

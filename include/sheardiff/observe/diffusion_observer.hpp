@@ -1,0 +1,38 @@
+#pragma once
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+#include "sheardiff/analysis/diffusion.hpp"
+#include "sheardiff/config.hpp"
+#include "sheardiff/observe/observer.hpp"
+
+namespace sheardiff {
+
+DiffusionSettings diffusion_settings(const Config& cfg);
+
+// Keeps, for every frame of the measured window, the unwrapped y and v_y / gammadot of the
+// mobile particles, and analyses them at the end of the run (analyse_diffusion). The frames are
+// exactly those written to the trajectory, so `sheardiff analyse DIR` recomputes the same numbers.
+class DiffusionObserver final : public Observer {
+ public:
+  // measuring(d): whether the frame belongs to the measured window.
+  DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
+                    std::function<bool(const Dynamics&)> measuring);
+  void on_frame(const StepView& v, std::vector<double>& values) override;
+  void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+
+ private:
+  DiffusionSettings settings_;
+  double frame_strain_;
+  std::filesystem::path file_;
+  std::function<bool(const Dynamics&)> measuring_;
+  std::vector<double> y_, vy_;
+  long frames_ = 0;
+};
+
+// Recomputes the diffusion analysis of a finished run from DIR/trajectory.h5, DIR/config.toml
+// and DIR/summary.json alone; rewrites DIR/analysis.h5 and the analysis keys of summary.json.
+nlohmann::json reanalyse_run(const std::filesystem::path& dir);
+
+}  // namespace sheardiff

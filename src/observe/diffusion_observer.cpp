@@ -1,0 +1,110 @@
+#include "sheardiff/observe/diffusion_observer.hpp"
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "sheardiff/io/h5md.hpp"
+
+namespace sheardiff {
+
+DiffusionSettings diffusion_settings(const Config& cfg) {
+  DiffusionSettings s;
+  s.window_lo = cfg.analysis.msd_window_lo;
+  s.window_hi = cfg.analysis.msd_window_hi;
+  s.reference_times = cfg.analysis.reference_times;
+  s.vacf_max_lag = cfg.analysis.vacf_max_lag;
+  s.seed = static_cast<std::uint64_t>(cfg.run.seed);
+  return s;
+}
+
+DiffusionObserver::DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
+                                     std::function<bool(const Dynamics&)> measuring)
+    : settings_(diffusion_settings(cfg)),
+      frame_strain_(cfg.output.frame_strain),
+      file_(std::move(analysis_file)),
+      measuring_(std::move(measuring)) {}
+
+void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
+  const Dynamics& d = v.dynamics;
+  if (!measuring_(d)) return;
+  const Particles& p = d.particles();
+  const double gd = d.flow().gammadot;
+  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+    y_.push_back(p.unwrapped[i].y());
+    vy_.push_back(v.velocities.u[i].y() / gd);
+  }
+  ++frames_;
+}
+
+void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
+  const auto n = static_cast<Eigen::Index>(d.particles().n_mobile);
+  if (frames_ < 4) {
+    js["analysis_warnings"] = {fmt::format(
+        "no diffusion analysis: only {} frames in the measured window", frames_)};
+    return;
+  }
+  // Row-major buffers (one frame per row) mapped as frames x particles.
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::MatrixXd y = Eigen::Map<const RowMajor>(y_.data(), frames_, n);
+  const Eigen::MatrixXd vy = Eigen::Map<const RowMajor>(vy_.data(), frames_, n);
+  const DiffusionReport r = analyse_diffusion(y, vy, frame_strain_, settings_);
+  add_to_summary(r, js);
+  if (!file_.empty()) write_analysis_file(r, file_);
+}
+
+nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
+  const auto traj = dir / "trajectory.h5";
+  const Config cfg = load_config(dir / "config.toml");
+  nlohmann::json js;
+  {
+    std::ifstream in(dir / "summary.json");
+    if (!in) throw std::runtime_error(fmt::format("{}: no summary.json (run not finished?)", dir.string()));
+    js = nlohmann::json::parse(in);
+  }
+  // The measured window: frames from the detection of steady state (pressure cell) or after
+  // the transient (simple shear), the same test the observer applied while running.
+  const bool pressure = cfg.scene.type == "pressure_shear";
+  if (pressure && !js.value("steady", false))
+    throw std::runtime_error(fmt::format("{}: the run never reached steady state", dir.string()));
+  const double from = pressure ? js["steady_detected_at"].get<double>() : cfg.run.transient_strain;
+  const ObservableSeries strain = read_h5md_observable(traj, "strain");
+  std::vector<long> frames;
+  for (std::size_t k = 0; k < strain.value.size(); ++k)
+    if (pressure ? strain.value[k] >= from : strain.value[k] > from) frames.push_back(static_cast<long>(k));
+  if (frames.size() < 4)
+    throw std::runtime_error(fmt::format("{}: only {} frames in the measured window", dir.string(),
+                                         frames.size()));
+  Eigen::MatrixXd y, vy;
+  for (std::size_t row = 0; row < frames.size(); ++row) {
+    const H5mdFrame f = read_h5md_frame(traj, frames[row]);
+    if (f.unwrapped.empty() || f.velocity.empty())
+      throw std::runtime_error(fmt::format("{}: frames lack unwrapped positions or velocities "
+                                           "(output.velocities = false?)", traj.string()));
+    std::vector<std::size_t> mobile;
+    for (std::size_t i = 0; i < f.position.size(); ++i)
+      if (f.motion.empty() || f.motion[i] == 0) mobile.push_back(i);
+    if (row == 0) {
+      y.resize(static_cast<Eigen::Index>(frames.size()), static_cast<Eigen::Index>(mobile.size()));
+      vy.resizeLike(y);
+    }
+    for (std::size_t c = 0; c < mobile.size(); ++c) {
+      y(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(c)) = f.unwrapped[mobile[c]].y();
+      vy(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(c)) =
+          f.velocity[mobile[c]].y() / cfg.flow.j;
+    }
+  }
+  const DiffusionReport r = analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg));
+  add_to_summary(r, js);
+  write_analysis_file(r, dir / "analysis.h5");
+  const auto tmp = (dir / "summary.json.tmp").string();
+  {
+    std::ofstream out(tmp);
+    out << js.dump(2) << "\n";
+  }
+  std::filesystem::rename(tmp, dir / "summary.json");
+  return js;
+}
+
+}  // namespace sheardiff
