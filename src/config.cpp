@@ -232,6 +232,10 @@ const std::vector<KeySpec>& schema() {
                      "persistence time Psi gammadot = 0.35 J^(1/4) (seed eq. 3.6b)."));
     s.push_back(boolean("output.velocities", &C::output, &C::Output::velocities,
                         "Write velocities and angular velocities to the trajectory."));
+    s.push_back(real("output.checkpoint_strain", &C::output, &C::Output::checkpoint_strain, 0.0,
+                     1e5, false, "1 (strain)",
+                     "Strain between two checkpoints (DIR/checkpoint.bin, written atomically at "
+                     "a frame); 0 = only on SIGINT/SIGTERM. Resume with --resume DIR."));
     s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
                         "Write DIR/trajectory.h5 (summary.json is always written)."));
     return s;
@@ -352,10 +356,6 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
   }
 }
 
-void resolve_defaults(Config& c) {
-  if (c.output.frame_strain == 0.0) c.output.frame_strain = 0.035 * std::pow(c.flow.j, 0.25);
-}
-
 void check_combinations(const Config& c, const std::string& origin) {
   if (c.analysis.msd_window_lo >= c.analysis.msd_window_hi)
     fail(origin, "analysis.msd_window_lo",
@@ -377,6 +377,10 @@ void check_combinations(const Config& c, const std::string& origin) {
 }
 
 }  // namespace
+
+void resolve_defaults(Config& c) {
+  if (c.output.frame_strain <= 0.0) c.output.frame_strain = 0.035 * std::pow(c.flow.j, 0.25);
+}
 
 Config parse_config(const std::string& toml_text, const std::string& origin,
                     const std::vector<std::string>& overrides) {

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <atomic>
+#include <csignal>
+#include <iterator>
 
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/observe/observer.hpp"
@@ -110,16 +113,96 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
   return obs;
 }
 
-nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
-                                bool progress) {
-  std::filesystem::create_directories(out_dir);
+namespace {
+
+std::atomic<int> g_stop_signal{0};
+extern "C" void on_stop_signal(int sig) { g_stop_signal.store(sig); }
+
+// Installs SIGINT/SIGTERM handlers for the lifetime of a run and restores the old ones.
+struct StopSignals {
+  struct sigaction old_int {}, old_term {};
+  StopSignals() {
+    g_stop_signal.store(0);
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
+  }
+};
+
+constexpr const char* kCheckpointMagic = "sheardiff-checkpoint-1";
+
+std::vector<char> read_bytes(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the checkpoint", file.string()));
+  return std::vector<char>(std::istreambuf_iterator<char>(in), {});
+}
+
+// Written to a temporary file, flushed to disk, then renamed: a checkpoint is whole or absent.
+void write_bytes_atomically(const std::filesystem::path& file, const std::vector<char>& bytes) {
+  const auto tmp = file.string() + ".tmp";
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw std::runtime_error(fmt::format("cannot write {}", tmp));
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() &&
+                  std::fflush(f) == 0 && fsync(fileno(f)) == 0;
+  std::fclose(f);
+  if (!ok) throw std::runtime_error(fmt::format("cannot write {}", tmp));
+  std::filesystem::rename(tmp, file);
+}
+
+}  // namespace
+
+nlohmann::json run_to_directory(const Config& given, const std::filesystem::path& out_dir,
+                                bool progress, bool resume) {
+  Config cfg = given;
+  resolve_defaults(cfg);
   const std::string resolved = to_toml(cfg);
-  write_text_atomically(out_dir / "config.toml", resolved);
+  const auto checkpoint_file = out_dir / "checkpoint.bin";
+  std::vector<char> checkpoint;
+  if (resume) {
+    if (!std::filesystem::exists(checkpoint_file))
+      throw ConfigError(fmt::format("--resume {}: no checkpoint.bin there", out_dir.string()));
+    checkpoint = read_bytes(checkpoint_file);
+  } else {
+    std::filesystem::create_directories(out_dir);
+    std::filesystem::remove(checkpoint_file);
+    std::filesystem::remove(out_dir / "summary.json");
+    write_text_atomically(out_dir / "config.toml", resolved);
+  }
 
   Simulation sim(cfg);
   Dynamics& d = sim.dynamics();
   const Particles& p = d.particles();
   auto observers = make_observers(cfg, out_dir);
+
+  double next_frame = cfg.output.frame_strain;
+  double next_checkpoint = cfg.output.checkpoint_strain;
+  double elapsed_before = 0.0;
+  long frames = 0;
+  // The whole evolving state of the run, in one fixed order for saving and loading.
+  const auto serialize = [&](Archive& a) {
+    std::string magic = kCheckpointMagic, config = resolved;
+    a.io(magic);
+    if (magic != kCheckpointMagic) throw std::runtime_error("checkpoint: not a sheardiff checkpoint");
+    a.io(config);
+    if (config != resolved)
+      throw ConfigError(fmt::format(
+          "--resume {}: the configuration differs from the one the checkpoint was written with "
+          "(see {}/config.toml)", out_dir.string(), out_dir.string()));
+    d.serialize(a);
+    sim.serialize_integrator(a);
+    for (auto& o : observers) o->serialize(a);
+    a.io(next_frame), a.io(next_checkpoint), a.io(elapsed_before), a.io(frames);
+  };
+  if (resume) {
+    Archive a = Archive::reader(std::move(checkpoint));
+    serialize(a);
+  }
 
   std::vector<std::string> names;
   for (const auto& o : observers)
@@ -138,13 +221,27 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
     layout.observables = names;
     layout.creator_version = SHEARDIFF_VERSION;
     layout.config_toml = resolved;
-    writer = std::make_unique<H5mdWriter>(out_dir / "trajectory.h5", layout);
+    const auto file = out_dir / "trajectory.h5";
+    writer = resume ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, frames))
+                    : std::make_unique<H5mdWriter>(file, layout);
   }
+  const auto save_checkpoint = [&](double elapsed_now) {
+    if (writer) writer->flush();  // the trajectory holds every frame the checkpoint counts
+    Archive a = Archive::writer();
+    double total = elapsed_before + elapsed_now;
+    std::swap(total, elapsed_before);
+    serialize(a);
+    std::swap(total, elapsed_before);
+    write_bytes_atomically(checkpoint_file, a.bytes());
+  };
 
+  StopSignals signals;
   const bool tty = progress && isatty(fileno(stderr));
   const auto t0 = std::chrono::steady_clock::now();
+  const auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   auto last_print = t0, last_flush = t0;
-  double next_frame = cfg.output.frame_strain;
   std::vector<double> values;
   const auto finished = [&] {
     for (const auto& o : observers)
@@ -153,6 +250,13 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
            (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
   };
   while (!finished()) {
+    if (const int sig = g_stop_signal.load()) {
+      save_checkpoint(seconds());
+      if (tty) std::fprintf(stderr, "\n");
+      throw RunInterrupted(sig, fmt::format(
+          "stopped by signal {} at step {} (strain {:.6g}); checkpoint written: resume with "
+          "`sheardiff run CONFIG --resume {}`", sig, d.steps(), d.strain(), out_dir.string()));
+    }
     sim.step();
     const StressSample s = sim.sample();
     const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
@@ -173,6 +277,12 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
         f.observables = values;
         writer->write_frame(f);
       }
+      ++frames;
+      if (cfg.output.checkpoint_strain > 0.0 && d.strain() >= next_checkpoint * (1.0 - 1e-12)) {
+        while (next_checkpoint <= d.strain() * (1.0 + 1e-12))
+          next_checkpoint += cfg.output.checkpoint_strain;
+        save_checkpoint(seconds());
+      }
     }
     const auto now = std::chrono::steady_clock::now();
     // A terminal gets a live line; a batch log gets one line a minute. The trajectory is
@@ -192,7 +302,7 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
     }
   }
   if (tty) std::fprintf(stderr, "\n");
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double wall = elapsed_before + seconds();
 
   nlohmann::json js;
   js["scene"] = cfg.scene.type;
@@ -206,6 +316,17 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   js["wall_seconds"] = wall;
   js["ms_per_step"] = 1e3 * wall / static_cast<double>(std::max<long>(d.steps(), 1));
   js["neighbour_rebuilds"] = d.neighbours().rebuilds();
+  js["factorisations"] = d.force_balance().system().factorisations();
+  {
+    // Which limit set the steps: where the step count comes from.
+    nlohmann::json by;
+    const auto& counts = d.step_limit_counts();
+    for (int k = 0; k < static_cast<int>(StepLimit::Count); ++k)
+      if (counts[k] > 0)
+        by[to_string(static_cast<StepLimit>(k))] =
+            static_cast<double>(counts[k]) / static_cast<double>(std::max<long>(d.steps(), 1));
+    js["dt_limited_by"] = by;
+  }
   js["lx"] = d.box().lx;
   js["ly"] = d.height();
   for (const auto& o : observers) o->finish(d, js, writer.get());
@@ -217,6 +338,8 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   if (writer) writer->flush();
   writer.reset();
   write_text_atomically(out_dir / "summary.json", js.dump(2) + "\n");
+  // Finished: the summary marks the run complete and the checkpoint has served its purpose.
+  std::filesystem::remove(checkpoint_file);
   return js;
 }
 

@@ -86,6 +86,7 @@ struct Config {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi
     bool velocities = true;
     bool trajectory = true;
+    double checkpoint_strain = 1.0;  // 0 = no periodic checkpoints
   } output;
 };
 
@@ -99,6 +100,9 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
                     const std::vector<std::string>& overrides = {});
 Config load_config(const std::filesystem::path& file,
                    const std::vector<std::string>& overrides = {});
+// Fills the defaults that depend on other keys (output.frame_strain = 0 -> from J). Done by
+// parse_config; call it on a Config built in code.
+void resolve_defaults(Config& cfg);
 // The resolved configuration as TOML (every key, defaults filled in).
 std::string to_toml(const Config& cfg);
 // Markdown table of every key: name, type, default, allowed range, unit, meaning.

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "sheardiff/config.hpp"
@@ -26,6 +27,7 @@ class Simulation {
   Dynamics& dynamics() { return *dynamics_; }
   const Dynamics& dynamics() const { return *dynamics_; }
   const Integrator& integrator() const { return *integrator_; }
+  void serialize_integrator(Archive& a) { integrator_->serialize(a); }
 
  private:
   Config cfg_;
@@ -36,9 +38,18 @@ class Simulation {
 // Contact stability limit of explicit springs for these parameters (model.md section 7).
 double explicit_stability_dt(const Config& cfg);
 
-// Runs cfg to its end, writing trajectory.h5, summary.json and config.toml into out_dir.
-// Returns the summary.
+// A run stopped by SIGINT/SIGTERM after writing its checkpoint.
+struct RunInterrupted : std::runtime_error {
+  RunInterrupted(int sig, const std::string& what) : std::runtime_error(what), signal(sig) {}
+  int signal;
+};
+
+// Runs cfg to its end, writing trajectory.h5 (H5MD), config.toml, checkpoint.bin every
+// output.checkpoint_strain, and at the end summary.json (whose presence marks a finished run;
+// the checkpoint is then removed). resume = continue from out_dir/checkpoint.bin, cutting the
+// trajectory back to the checkpoint's frames; the continuation is bit-identical to a run that
+// was never stopped. Returns the summary.
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
-                                bool progress);
+                                bool progress, bool resume = false);
 
 }  // namespace sheardiff

@@ -28,7 +28,8 @@ DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixX
   r.reference_times = static_cast<long>(t0.size());
   r.msd = mean_square_displacement(y, frame_strain, max_lag, t0);
   r.window_hi = std::min(s.window_hi, max_lag * frame_strain);
-  r.window_lo = std::min(s.window_lo, 0.5 * r.window_hi);
+  // Only a window cut short by the data moves its start (to keep some points in it).
+  r.window_lo = r.window_hi < s.window_hi ? std::min(s.window_lo, 0.5 * r.window_hi) : s.window_lo;
   if (r.window_hi < s.window_hi)
     r.warnings.push_back(fmt::format(
         "the measured window ({:.3g} strains) is shorter than the MSD fit window [{:g}, {:g}]: "

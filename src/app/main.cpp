@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
 #include <iostream>
 
 #include "sheardiff/config.hpp"
@@ -18,6 +20,15 @@ constexpr int kExitNumerical = 3;
 }  // namespace
 
 int main(int argc, char** argv) {
+  // CHOLMOD (Debian's build) opens OpenMP regions with a fixed num_threads clause inside its
+  // supernodal factorisation; only OMP_THREAD_LIMIT, read when libgomp loads, caps them. Spare
+  // threads spin and cost a shared 2-core machine ~40%, and sweeps already run one process per
+  // core, so sheardiff runs single-threaded unless the caller sets OMP_THREAD_LIMIT itself
+  // (docs/performance.md). Setting it needs a fresh process image: re-execute once.
+  if (std::getenv("OMP_THREAD_LIMIT") == nullptr) {
+    setenv("OMP_THREAD_LIMIT", "1", 1);
+    execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+  }
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
   app.require_subcommand(1);
 
@@ -32,6 +43,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run->add_option("--set", overrides,
                   "Override one key, section.key=value (repeatable), e.g. --set flow.J=1e-3");
+  std::string resume_dir;
+  run->add_option("--resume", resume_dir,
+                  "Continue the run in DIR from its checkpoint.bin (same CONFIG and --set); the "
+                  "trajectory is cut back to the checkpoint, the result is bit-identical to an "
+                  "uninterrupted run");
 
   auto* check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
@@ -69,7 +85,9 @@ int main(int argc, char** argv) {
       std::cout << sheardiff::to_toml(cfg);
       return 0;
     }
-    const auto summary = sheardiff::run_to_directory(cfg, out_dir, true);
+    const bool resume = !resume_dir.empty();
+    if (resume) out_dir = resume_dir;
+    const auto summary = sheardiff::run_to_directory(cfg, out_dir, true, resume);
     fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
                out_dir, summary["strain"].get<double>(), summary["steps"].get<long>(),
                summary["wall_seconds"].get<double>(), summary["ms_per_step"].get<double>(),
@@ -89,6 +107,8 @@ int main(int argc, char** argv) {
                    summary["pressure_max_relative_error"].get<double>(),
                    summary["steps"].get<long>() - summary["wall_free_fall_steps"].get<long>());
       }
+    } else if (summary["shear_stress"].is_null()) {
+      fmt::print("  no averages: the run ended before run.transient_strain\n");
     } else {
       fmt::print("  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
                  summary["shear_stress"].get<double>(), summary["pressure"].get<double>(),
@@ -104,6 +124,9 @@ int main(int argc, char** argv) {
       for (const auto& w : summary["analysis_warnings"])
         fmt::print(stderr, "warning: {}\n", w.get<std::string>());
     return 0;
+  } catch (const sheardiff::RunInterrupted& e) {
+    fmt::print(stderr, "{}\n", e.what());
+    return 128 + e.signal;
   } catch (const sheardiff::ConfigError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitConfig;

@@ -51,10 +51,32 @@ bool Dynamics::solve(double dt_implicit, Velocities& v) {
                               wall_drive(), v);
 }
 
-double Dynamics::dt_limit(const Velocities& v) const {
-  if (limits_.fixed_dt > 0.0) return limits_.fixed_dt;
+const char* to_string(StepLimit l) {
+  switch (l) {
+    case StepLimit::Fixed: return "fixed";
+    case StepLimit::Strain: return "strain";
+    case StepLimit::Displacement: return "displacement";
+    case StepLimit::Gap: return "gap";
+    case StepLimit::Overlap: return "overlap";
+    case StepLimit::Explicit: return "explicit_stability";
+    case StepLimit::Growth: return "growth";
+    case StepLimit::Count: break;
+  }
+  return "?";
+}
+
+double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
+  StepLimit why = StepLimit::Fixed;
+  const auto take = [&](double cand, double& dt, StepLimit l) {
+    if (cand < dt) dt = cand, why = l;
+  };
+  if (limits_.fixed_dt > 0.0) {
+    if (which) *which = why;
+    return limits_.fixed_dt;
+  }
   constexpr double kBig = std::numeric_limits<double>::infinity();
   double dt = flow_.gammadot > 0.0 ? limits_.max_strain_step / flow_.gammadot : kBig;
+  why = StepLimit::Strain;
   double vmax = 0.0;
   for (std::size_t i = 0; i < particles_.n_mobile; ++i) {
     const Vec3 na = v.u[i] - flow_.velocity(particles_.position[i]);
@@ -62,7 +84,7 @@ double Dynamics::dt_limit(const Velocities& v) const {
   }
   vmax = std::sqrt(vmax);
   if (walls_) vmax = std::max(vmax, std::abs(v.wall_v));
-  if (vmax > 0.0) dt = std::min(dt, limits_.max_displacement / vmax);
+  if (vmax > 0.0) take(limits_.max_displacement / vmax, dt, StepLimit::Displacement);
 
   const auto& pairs = neighbours_.pairs();
   const auto& terms = force_balance_.terms();
@@ -73,13 +95,14 @@ double Dynamics::dt_limit(const Velocities& v) const {
     const Vec3 uj = v.u[pairs[k].j] + t.image_j;
     const double opening = t.g.n.dot(uj.head<2>() - v.u[pairs[k].i].head<2>());
     if (pairs[k].contact.active) {
-      if (opening != 0.0) dt = std::min(dt, limits_.max_overlap_change / std::abs(opening));
+      if (opening != 0.0) take(limits_.max_overlap_change / std::abs(opening), dt, StepLimit::Overlap);
     } else if (opening < 0.0) {
       const double room = (t.g.r - t.g.s) + 0.5 * delta * t.g.s;
-      dt = std::min(dt, limits_.max_gap_fraction * room / -opening);
+      take(limits_.max_gap_fraction * room / -opening, dt, StepLimit::Gap);
     }
   }
-  if (limits_.explicit_dt > 0.0) dt = std::min(dt, limits_.explicit_dt);
+  if (limits_.explicit_dt > 0.0) take(limits_.explicit_dt, dt, StepLimit::Explicit);
+  if (which) *which = why;
   return dt;
 }
 
@@ -125,6 +148,21 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   time_ += dt;
   neighbours_.advance(na_, flow_.gammadot * dt);
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
+}
+
+void Dynamics::serialize(Archive& a) {
+  a.tag("dynamics");
+  a.io(particles_.position);
+  a.io(particles_.unwrapped);
+  a.io(particles_.velocity);
+  a.io(box_);
+  a.io(time_);
+  a.io(steps_);
+  a.io(rebuild_due_);
+  a.io(limit_counts_);
+  a.io(drive_);
+  neighbours_.serialize(a);
+  if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs());
 }
 
 Dynamics::Saved Dynamics::save() const {

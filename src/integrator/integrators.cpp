@@ -8,7 +8,9 @@ bool ExplicitEuler::step(Dynamics& d) {
   d.begin_step();
   if (!d.solve(0.0, last_)) return false;
   ++solves_;
-  dt_ = d.dt_limit(last_);
+  StepLimit why;
+  dt_ = d.dt_limit(last_, &why);
+  d.count_step_limit(why);
   d.advance(dt_, last_);
   d.finish_step();
   return true;
@@ -18,7 +20,9 @@ bool Heun::step(Dynamics& d) {
   d.begin_step();
   if (!d.solve(0.0, predictor_)) return false;
   ++solves_;
-  dt_ = d.dt_limit(predictor_);
+  StepLimit why;
+  dt_ = d.dt_limit(predictor_, &why);
+  d.count_step_limit(why);
   const Dynamics::Saved start = d.save();
   d.advance(dt_, predictor_, /*allow_rebuild=*/false);
   const bool ok = d.solve(0.0, last_);
@@ -42,18 +46,23 @@ bool ImplicitSprings::step(Dynamics& d) {
     ++solves_;
     dt = d.dt_limit(last_);
   }
+  StepLimit why = fixed ? StepLimit::Fixed : limit_of_next_;
   for (int attempt = 0;; ++attempt) {
     if (!d.solve(dt, last_)) return false;
     ++solves_;
     if (fixed) break;
-    const double allowed = d.dt_limit(last_);
+    StepLimit now;
+    const double allowed = d.dt_limit(last_, &now);
     if (dt <= overshoot_ * allowed || attempt == 3) {
       next_dt_ = std::min(growth_ * dt, allowed);
+      limit_of_next_ = growth_ * dt < allowed ? StepLimit::Growth : now;
       break;
     }
     dt = allowed;
+    why = now;
     ++redos_;
   }
+  d.count_step_limit(why);
   dt_ = dt;
   d.advance(dt_, last_);
   d.finish_step();

@@ -194,6 +194,28 @@ Series create_series(hid_t loc, const std::string& full, hid_t file_type,
   return s;
 }
 
+// Opens an existing series and cuts it back to `rows` rows.
+Series open_series(hid_t loc, const std::string& full, std::vector<hsize_t> inner, hsize_t rows,
+                   const fs::path& file) {
+  Series s;
+  s.ds = checked(H5Dopen2(loc, full.c_str(), H5P_DEFAULT), H5Dclose, file, full,
+                 "cannot open dataset");
+  s.name = full;
+  s.inner = std::move(inner);
+  Handle space = checked(H5Dget_space(s.ds.get()), H5Sclose, file, full, "cannot get dataspace");
+  hsize_t have = 0;
+  if (H5Sget_simple_extent_ndims(space.get()) < 1) fail(file, full, "expected rank >= 1");
+  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space.get())));
+  H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+  have = dims[0];
+  if (have < rows)
+    fail(file, full, fmt::format("holds {} rows, the checkpoint needs {}", have, rows));
+  dims[0] = rows;
+  check(H5Dset_extent(s.ds.get(), dims.data()), file, full, "cannot truncate dataset");
+  s.rows = rows;
+  return s;
+}
+
 // H5MD time-dependent element: group with step, time and value.
 struct TimeElement {
   Handle group;
@@ -441,6 +463,44 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     m.observables.push_back(create_element(f, "/observables/" + name, {}, kScalarChunk, path));
   }
   check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
+}
+
+H5mdWriter::H5mdWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layout,
+                              long keep_frames) {
+  auto m = std::make_unique<Impl>();
+  m->path = path;
+  m->layout = layout;
+  {
+    ErrorPrintGuard quiet;
+    m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, path,
+                      "/", "cannot reopen the trajectory to resume it");
+  }
+  const hid_t f = m->file.get();
+  const auto rows = static_cast<hsize_t>(keep_frames);
+  const hsize_t n = layout.n_particles;
+  const auto element = [&](const std::string& full, std::vector<hsize_t> inner) {
+    TimeElement e;
+    e.group = checked(H5Gopen2(f, full.c_str(), H5P_DEFAULT), H5Gclose, path, full,
+                      "cannot open group");
+    e.step = open_series(f, full + "/step", {}, rows, path);
+    e.time = open_series(f, full + "/time", {}, rows, path);
+    e.value = open_series(f, full + "/value", std::move(inner), rows, path);
+    return e;
+  };
+  m->edges = element(susp("box/edges"), {2});
+  m->position = element(susp("position"), {n, 2});
+  if (layout.write_velocity) {
+    m->velocity = element(susp("velocity"), {n, 2});
+    m->angular_velocity = element(susp("angular_velocity"), {n});
+  }
+  if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0)
+    m->unwrapped = element(susp("unwrapped_position"), {n, 2});
+  for (const auto& name : layout.observables) m->observables.push_back(element("/observables/" + name, {}));
+  m->frames = keep_frames;
+  check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
+  return H5mdWriter(std::move(m));
 }
 
 H5mdWriter::~H5mdWriter() = default;

@@ -26,14 +26,20 @@ void RheologyObserver::on_step(const StepView& v) {
 }
 
 void RheologyObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
-  const double w = weight_ > 0 ? weight_ : 1.0;
   js["max_overlap"] = max_overlap_;
+  js["averaged_from_strain"] = transient_;
+  if (weight_ <= 0.0) {
+    // Nothing to average: the run ended before run.transient_strain.
+    for (const char* k : {"mean_overlap", "shear_stress", "pressure", "contacts_per_particle", "viscosity"})
+      js[k] = nullptr;
+    return;
+  }
+  const double w = weight_;
   js["mean_overlap"] = mean_overlap_ / w;
   js["shear_stress"] = sxy_ / w;
   js["pressure"] = pressure_ / w;
   js["contacts_per_particle"] = contacts_ / w / static_cast<double>(d.particles().n_mobile);
   js["viscosity"] = d.flow().gammadot > 0 ? sxy_ / w / d.flow().gammadot : 0.0;
-  js["averaged_from_strain"] = transient_;
 }
 
 }  // namespace sheardiff

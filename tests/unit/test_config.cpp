@@ -11,8 +11,11 @@
 namespace sheardiff {
 namespace {
 
-// Every field of two configurations, compared exactly (a round trip must not lose a bit).
-void expect_same_config(const Config& a, const Config& b) {
+// Every field of two configurations, compared exactly (a round trip must not lose a bit), after
+// the defaults that depend on other keys are filled in (output.frame_strain from J).
+void expect_same_config(Config a, Config b) {
+  resolve_defaults(a);
+  resolve_defaults(b);
   EXPECT_EQ(a.scene.type, b.scene.type);
   EXPECT_EQ(a.particles.n, b.particles.n);
   EXPECT_EQ(a.particles.mix, b.particles.mix);
@@ -52,6 +55,13 @@ void expect_same_config(const Config& a, const Config& b) {
   EXPECT_EQ(a.output.frame_strain, b.output.frame_strain);
   EXPECT_EQ(a.output.velocities, b.output.velocities);
   EXPECT_EQ(a.output.trajectory, b.output.trajectory);
+  EXPECT_EQ(a.output.checkpoint_strain, b.output.checkpoint_strain);
+  EXPECT_EQ(a.solver.cholesky, b.solver.cholesky);
+  EXPECT_EQ(a.analysis.diffusion, b.analysis.diffusion);
+  EXPECT_EQ(a.analysis.msd_window_lo, b.analysis.msd_window_lo);
+  EXPECT_EQ(a.analysis.msd_window_hi, b.analysis.msd_window_hi);
+  EXPECT_EQ(a.analysis.reference_times, b.analysis.reference_times);
+  EXPECT_EQ(a.analysis.vacf_max_lag, b.analysis.vacf_max_lag);
 }
 
 // The message of the ConfigError thrown by parse_config, or "" (and a failure) if none is.

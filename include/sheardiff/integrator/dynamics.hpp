@@ -1,7 +1,9 @@
 #pragma once
+#include <array>
 #include <optional>
 #include <vector>
 
+#include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/box.hpp"
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
@@ -19,6 +21,10 @@ struct StepLimits {
   double max_strain_step = 1e-2;
   double explicit_dt = 0.0;        // stability cap of explicit springs (0 = none)
 };
+
+// Which limit set a step (reported as fractions of steps in summary.json).
+enum class StepLimit : int { Fixed, Strain, Displacement, Gap, Overlap, Explicit, Growth, Count };
+const char* to_string(StepLimit l);
 
 // The two rough walls: the bottom one fixed, the top one driven at Vx = gammadot H and floating
 // in y under the load P Lx lz. Indices refer to Particles.
@@ -39,14 +45,22 @@ class Dynamics {
   void begin_step();
   // Velocities at the current configuration; dt_implicit > 0 for implicit springs.
   bool solve(double dt_implicit, Velocities& v);
-  // Largest step the limits allow for these velocities (fixed_dt if set).
-  double dt_limit(const Velocities& v) const;
+  // Largest step the limits allow for these velocities (fixed_dt if set); *which says which.
+  double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
+  // Integrators report the limit that set each step they take.
+  void count_step_limit(StepLimit l) { ++limit_counts_[static_cast<int>(l)]; }
+  const std::array<long, static_cast<int>(StepLimit::Count)>& step_limit_counts() const {
+    return limit_counts_;
+  }
   // Move particles, walls and the Lees-Edwards offset by dt with velocities v; stretch the
   // tangential springs with the slip of v; when the skin is used up the neighbour list is
   // rebuilt at the next begin_step() (never after a predictor move, allow_rebuild = false,
   // that restore() will undo).
   void advance(double dt, const Velocities& v, bool allow_rebuild = true);
   void finish_step() { ++steps_; }
+
+  // Everything that evolves (for checkpoints); loading re-derives the matrix pattern.
+  void serialize(Archive& a);
 
   struct Saved {
     std::vector<Vec2> position, unwrapped;
@@ -91,6 +105,7 @@ class Dynamics {
   double time_ = 0.0;
   long steps_ = 0;
   bool rebuild_due_ = false;
+  std::array<long, static_cast<int>(StepLimit::Count)> limit_counts_{};
   std::vector<Vec2> na_;  // scratch: non-affine displacement of the last step
 };
 

@@ -18,6 +18,15 @@ class Integrator {
   long solves() const { return solves_; }
   // Whether the springs sit inside the matrix (the force balance must keep the full pattern).
   virtual bool implicit_springs() const { return false; }
+  // Step-size memory and counters, for checkpoints.
+  virtual void serialize(Archive& a) {
+    a.tag("integrator");
+    a.io(dt_);
+    a.io(solves_);
+    a.io(last_.u);
+    a.io(last_.wall_v);
+    a.io(last_.wall_free_fall);
+  }
 
  protected:
   Velocities last_;
@@ -50,10 +59,17 @@ class ImplicitSprings final : public Integrator {
   bool step(Dynamics& d) override;
   bool implicit_springs() const override { return true; }
   long redos() const { return redos_; }
+  void serialize(Archive& a) override {
+    Integrator::serialize(a);
+    a.io(next_dt_);
+    a.io(limit_of_next_);
+    a.io(redos_);
+  }
 
  private:
   double growth_, overshoot_;
   double next_dt_ = 0.0;
+  StepLimit limit_of_next_ = StepLimit::Displacement;
   long redos_ = 0;
 };
 

@@ -39,6 +39,11 @@ class H5mdWriter {
  public:
   // Creates or truncates `file`. Requires n_particles > 0 and per-particle arrays of that size.
   H5mdWriter(const std::filesystem::path& file, const TrajectoryLayout& layout);
+  // Reopens a trajectory written with `layout` to continue it after a checkpoint: every
+  // time-dependent dataset is cut back to its first `keep_frames` rows, so frames written after
+  // the checkpoint are neither duplicated nor kept. Throws if the file holds fewer frames.
+  static H5mdWriter resume(const std::filesystem::path& file, const TrajectoryLayout& layout,
+                           long keep_frames);
   ~H5mdWriter();  // flush + close, never throws
   H5mdWriter(const H5mdWriter&) = delete;
   H5mdWriter& operator=(const H5mdWriter&) = delete;
@@ -56,6 +61,7 @@ class H5mdWriter {
 
  private:
   struct Impl;
+  explicit H5mdWriter(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
 

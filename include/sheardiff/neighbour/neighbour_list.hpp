@@ -2,6 +2,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/box.hpp"
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/interactions/contact.hpp"
@@ -37,6 +38,13 @@ class NeighbourList {
   std::vector<Pair>& pairs() { return pairs_; }
   std::size_t rebuilds() const { return rebuilds_; }
   double skin() const { return skin_; }
+  void serialize(Archive& a) {
+    a.io(pairs_);
+    a.io(na_since_build_);
+    a.io(strain_since_build_);
+    a.io(max_cutoff_);
+    a.io(rebuilds_);
+  }
   // Pair cut-off distance for radii ai, aj.
   double cutoff(double ai, double aj) const { return (ai + aj) * range_factor_ + skin_; }
 

@@ -21,6 +21,10 @@ class DiffusionObserver final : public Observer {
                     std::function<bool(const Dynamics&)> measuring);
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+  void serialize(Archive& a) override {
+    a.tag("diffusion");
+    a.io(y_), a.io(vy_), a.io(frames_);
+  }
 
  private:
   DiffusionSettings settings_;

@@ -31,6 +31,8 @@ class Observer {
   virtual void on_step(const StepView&) {}
   // Whether the run may stop now (e.g. measured long enough after steady state).
   virtual bool done(const Dynamics&) const { return false; }
+  // Accumulated state, for checkpoints.
+  virtual void serialize(Archive& a) { (void)a; }
   // Results into summary.json, tables into the trajectory (writer may be null).
   virtual void finish(const Dynamics&, nlohmann::json& summary, H5mdWriter* writer) {
     (void)summary;
@@ -46,6 +48,10 @@ class RheologyObserver final : public Observer {
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void on_step(const StepView& v) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+  void serialize(Archive& a) override {
+    a.tag("rheology");
+    for (double* x : {&weight_, &sxy_, &pressure_, &contacts_, &mean_overlap_, &max_overlap_}) a.io(*x);
+  }
 
  private:
   double transient_;

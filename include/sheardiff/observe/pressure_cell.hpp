@@ -21,6 +21,16 @@ class PressureCellObserver final : public Observer {
   bool done(const Dynamics& d) const override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
 
+  void serialize(Archive& a) override {
+    a.tag("pressure_cell");
+    a.io(hist_strain_), a.io(hist_h_), a.io(hist_mu_);
+    for (double* x : {&steady_at_, &steady_from_, &w_, &h_, &phi_, &phi2_, &mu_top_, &mu_bottom_,
+                      &p_meas_, &max_p_err_})
+      a.io(*x);
+    a.io(free_fall_steps_);
+    for (auto* v : {&prof_w_, &prof_area_, &prof_n_, &prof_ux_, &prof_ux2_, &prof_uy2_}) a.io(*v);
+  }
+
   bool steady() const { return steady_at_ >= 0.0; }
   double steady_strain() const { return steady_from_; }
   // Bulk area fraction of the current configuration.

@@ -1,0 +1,87 @@
+#pragma once
+// A symmetric binary archive for checkpoints: the same serialize(Archive&) member saves and
+// loads, so what is written is what is read. Only for trivially copyable values, vectors and
+// strings; the file format is this machine's (checkpoints resume on the machine kind that wrote
+// them).
+#include <Eigen/Core>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace sheardiff {
+
+class Archive {
+ public:
+  static Archive writer() { return Archive(false, {}); }
+  static Archive reader(std::vector<char> bytes) { return Archive(true, std::move(bytes)); }
+
+  bool loading() const { return loading_; }
+  const std::vector<char>& bytes() const { return buf_; }
+  bool at_end() const { return pos_ == buf_.size(); }
+
+  template <class T>
+    requires(std::is_trivially_copyable_v<T> && !requires(T& t, Archive& a) { t.serialize(a); })
+  void io(T& x) {
+    raw(&x, sizeof(T));
+  }
+  template <class T>
+  void io(std::vector<T>& v) {
+    std::uint64_t n = v.size();
+    io(n);
+    if (loading_) v.resize(n);
+    if constexpr (std::is_trivially_copyable_v<T>) {
+      raw(v.data(), n * sizeof(T));
+    } else {
+      for (auto& x : v) io(x);
+    }
+  }
+  template <class S, int R, int C, int O, int MR, int MC>
+    requires(R > 0 && C > 0)
+  void io(Eigen::Matrix<S, R, C, O, MR, MC>& m) {
+    raw(m.data(), sizeof(S) * R * C);
+  }
+  void io(std::vector<bool>& v) {
+    std::vector<std::uint8_t> b(v.begin(), v.end());
+    io(b);
+    if (loading_) v.assign(b.begin(), b.end());
+  }
+  void io(std::string& s) {
+    std::uint64_t n = s.size();
+    io(n);
+    if (loading_) s.resize(n);
+    raw(s.data(), n);
+  }
+  template <class T>
+    requires requires(T& t, Archive& a) { t.serialize(a); }
+  void io(T& x) {
+    x.serialize(*this);
+  }
+  // A named check point inside the stream: a mismatch means a corrupt or foreign file.
+  void tag(const char* name) {
+    std::string s = name;
+    std::string got = s;
+    io(got);
+    if (got != s) throw std::runtime_error("checkpoint: expected section '" + s + "', found '" + got + "'");
+  }
+
+ private:
+  Archive(bool loading, std::vector<char> bytes) : loading_(loading), buf_(std::move(bytes)) {}
+  void raw(void* p, std::size_t n) {
+    if (loading_) {
+      if (pos_ + n > buf_.size()) throw std::runtime_error("checkpoint: file is truncated");
+      std::memcpy(p, buf_.data() + pos_, n);
+      pos_ += n;
+    } else {
+      const char* c = static_cast<const char*>(p);
+      buf_.insert(buf_.end(), c, c + n);
+    }
+  }
+  bool loading_;
+  std::vector<char> buf_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace sheardiff
