@@ -49,9 +49,14 @@ void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const Eigen::MatrixXd y = Eigen::Map<const RowMajor>(y_.data(), frames_, n);
   const Eigen::MatrixXd vy = Eigen::Map<const RowMajor>(vy_.data(), frames_, n);
-  const DiffusionReport r = analyse_diffusion(y, vy, frame_strain_, settings_);
-  add_to_summary(r, js);
-  if (!file_.empty()) write_analysis_file(r, file_);
+  try {
+    const DiffusionReport r = analyse_diffusion(y, vy, frame_strain_, settings_);
+    add_to_summary(r, js);
+    if (!file_.empty()) write_analysis_file(r, file_);
+  } catch (const std::invalid_argument& e) {
+    // Too little data for the fits is a finding about the run, not a reason to lose it.
+    js["analysis_warnings"] = {fmt::format("no diffusion analysis: {}", e.what())};
+  }
 }
 
 nlohmann::json reanalyse_run(const std::filesystem::path& dir) {

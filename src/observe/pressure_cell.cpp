@@ -137,7 +137,10 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["pressure_max_relative_error"] = max_p_err_;
   js["wall_free_fall_steps"] = free_fall_steps_;
   if (!steady() || w_ <= 0.0) {
-    js["note"] = "steady state not reached: H or mu still drift; run longer (run.strain)";
+    js["steady"] = false;
+    js["note"] = steady() ? "steady state detected at the last step: nothing measured after it; "
+                            "run longer (run.strain)"
+                          : "steady state not reached: H or mu still drift; run longer (run.strain)";
     js["H"] = d.height();
     js["phi"] = bulk_phi(d, exclusion_);
     return;
