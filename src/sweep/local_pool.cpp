@@ -2,6 +2,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -22,7 +23,34 @@ extern char** environ;
 namespace sheardiff {
 namespace fs = std::filesystem;
 
+namespace {
+
+// An exclusive lock on FILE held for the lifetime of this object (released by the kernel if the
+// process dies): two processes must never run the same point or pool the same sweep folder.
+class FileLock {
+ public:
+  FileLock(const fs::path& file, const std::string& what) {
+    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error(fmt::format("cannot open {}", file.string()));
+    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw ConfigError(
+          fmt::format("{} is already being run by another process (lock {})", what, file.string()));
+    }
+  }
+  ~FileLock() { ::close(fd_); }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
 void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
+  fs::create_directories(out_dir / "logs");
+  const FileLock lock(out_dir / "logs" / (p.name + ".lock"), "sweep point " + p.name);
   const auto state = point_state(spec, p, out_dir);
   if (state == PointState::finished) return;
   const Config cfg = load_config(spec.base, p.overrides);
@@ -54,6 +82,7 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
   const auto points = expand_points(spec);
   fs::create_directories(out_dir / "points");
   fs::create_directories(out_dir / "logs");
+  const FileLock lock(out_dir / "sweep.lock", "the sweep in " + out_dir.string());
 
   // States first (a foreign directory stops the sweep before anything starts), longest first.
   std::vector<const SweepPoint*> todo;

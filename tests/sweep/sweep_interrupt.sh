@@ -27,6 +27,10 @@ for _ in $(seq 600); do  # up to 120 s for the first point to finish
   sleep 0.2
 done
 compgen -G "out/points/*/summary.json" > /dev/null || { echo "no point finished"; cat first.log; exit 1; }
+# A second sweep on the same folder while the first runs is refused (exit 2), touching nothing.
+rc=0; "$bin" sweep tiny.toml --out out > concurrent.log 2>&1 || rc=$?
+[ "$rc" = 2 ] && grep -q "already being run by another process" concurrent.log ||
+  { echo "concurrent sweep: exit $rc"; cat concurrent.log; exit 1; }
 kill -KILL -- -"$pgid"
 wait "$pgid" 2>/dev/null || true
 
