@@ -11,12 +11,14 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
+#include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace {
-// Exit codes (docs/config.md): 0 done, 2 invalid config or input, 3 the run failed numerically,
-// 1 anything else (I/O).
+// Exit codes (README, docs/stability.md): 0 done, 2 invalid config or input, 3 the run failed
+// numerically outside the step loop, 4 stopped by a run health check (kExitUnhealthy), 1
+// anything else (I/O), 128 + signal after SIGINT/SIGTERM.
 constexpr int kExitConfig = 2;
 constexpr int kExitNumerical = 3;
 int run_sweep(const std::string& file, const std::filesystem::path& out, int jobs,
@@ -76,6 +78,24 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
   return fits["finished"].get<long>() == fits["points"].get<long>() ? 0 : kExitNumerical;
 }
 
+// A summary value, NaN when absent or not a number: summaries of older versions or of runs
+// that ended early lack some keys, and printing must not abort on them.
+double num(const nlohmann::json& js, const char* key) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_number() ? it->get<double>() : NAN;
+}
+double num_at(const nlohmann::json& js, const char* key, std::size_t i) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_array() && i < it->size() && (*it)[i].is_number()
+             ? (*it)[i].get<double>()
+             : NAN;
+}
+void print_warnings(const nlohmann::json& js) {
+  const auto it = js.find("analysis_warnings");
+  if (it == js.end() || !it->is_array()) return;
+  for (const auto& w : *it)
+    if (w.is_string()) fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -155,16 +175,15 @@ int main(int argc, char** argv) {
           "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
           "(log-log slope {:.3f}); dv = {:.4g} gammadot d; Psi = {:.4g} / gammadot; "
           "step length {:.4g} d\n",
-          run_dir, js["D"].get<double>(), js["D_stderr"].get<double>(),
-          js["msd_window"][0].get<double>(), js["msd_window"][1].get<double>(),
-          js["msd_window_slope"].is_null() ? NAN : js["msd_window_slope"].get<double>(),
-          js["dv"].get<double>(), js["psi"].get<double>(), js["step_length"].get<double>());
-      for (const auto& w : js["analysis_warnings"])
-        fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+          run_dir, num(js, "D"), num(js, "D_stderr"), num_at(js, "msd_window", 0),
+          num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"), num(js, "psi"),
+          num(js, "step_length"));
+      print_warnings(js);
       return 0;
     }
     if (sweep->parsed()) return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only);
     const sheardiff::Config cfg = sheardiff::load_config(config_path, overrides);
+    sheardiff::validate_run_inputs(cfg, config_path);
     if (check->parsed()) {
       std::cout << sheardiff::to_toml(cfg);
       return 0;
@@ -172,45 +191,53 @@ int main(int argc, char** argv) {
     const bool resume = !resume_dir.empty();
     if (resume) out_dir = resume_dir;
     const auto summary = sheardiff::run_to_directory(cfg, out_dir, true, resume);
+    const auto flag = [&](const char* key) {
+      const auto it = summary.find(key);
+      return it != summary.end() && it->is_boolean() && it->get<bool>();
+    };
+    const auto count = [&](const char* key) {
+      const auto it = summary.find(key);
+      return it != summary.end() && it->is_number() ? it->get<long>() : 0L;
+    };
     fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
-               out_dir, summary["strain"].get<double>(), summary["steps"].get<long>(),
-               summary["wall_seconds"].get<double>(), summary["ms_per_step"].get<double>(),
-               summary["max_overlap"].get<double>());
+               out_dir, num(summary, "strain"), count("steps"), num(summary, "wall_seconds"),
+               num(summary, "ms_per_step"), num(summary, "max_overlap"));
     if (summary.contains("steady")) {
-      if (!summary["steady"].get<bool>()) {
+      if (!flag("steady")) {
         fmt::print("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
-                   summary["phi"].get<double>());
+                   num(summary, "phi"));
       } else {
         fmt::print(
             "  steady from strain {:.3g}: phi = {:.4f} +- {:.4f}, mu = {:.4f}, H = {:.3f} d\n",
-            summary["steady_strain"].get<double>(), summary["phi"].get<double>(),
-            summary["phi_std"].get<double>(), summary["mu"].get<double>(),
-            summary["H"].get<double>());
+            num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_std"),
+            num(summary, "mu"), num(summary, "H"));
         fmt::print(
             "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
             "held steps)\n",
-            summary["pressure_measured"].get<double>(),
-            summary["pressure_max_relative_error"].get<double>(),
-            summary["steps"].get<long>() - summary["wall_free_fall_steps"].get<long>());
+            num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
+            count("steps") - count("wall_free_fall_steps"));
       }
-    } else if (summary["shear_stress"].is_null()) {
+    } else if (std::isnan(num(summary, "shear_stress"))) {
       fmt::print("  no averages: the run ended before run.transient_strain\n");
     } else {
       fmt::print("  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
-                 summary["shear_stress"].get<double>(), summary["pressure"].get<double>(),
-                 summary["viscosity"].get<double>());
+                 num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
     }
     if (summary.contains("D"))
       fmt::print(
           "  diffusion: D = {:.4g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
           "gammadot d, Psi = {:.4g} / gammadot\n",
-          summary["D"].get<double>(), summary["msd_window"][0].get<double>(),
-          summary["msd_window"][1].get<double>(), summary["dv"].get<double>(),
-          summary["psi"].get<double>());
-    if (summary.contains("analysis_warnings"))
-      for (const auto& w : summary["analysis_warnings"])
-        fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+          num(summary, "D"), num_at(summary, "msd_window", 0), num_at(summary, "msd_window", 1),
+          num(summary, "dv"), num(summary, "psi"));
+    print_warnings(summary);
     return 0;
+  } catch (const sheardiff::RunUnhealthy& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "  diagnostic frame: {}/diagnostic.txt; checkpoint {}\n", out_dir,
+               e.report.state_finite ? "written at this step"
+                                     : "not written (state not finite; "
+                                       "the previous one, if any, kept)");
+    return sheardiff::kExitUnhealthy;
   } catch (const sheardiff::RunInterrupted& e) {
     fmt::print(stderr, "{}\n", e.what());
     return 128 + e.signal;

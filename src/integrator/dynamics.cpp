@@ -65,6 +65,11 @@ const char* to_string(StepLimit l) {
   return "?";
 }
 
+double Dynamics::fixed_step() const {
+  const double rest = limits_.end_time - time_;
+  return rest > 0.0 && rest < limits_.fixed_dt ? rest : limits_.fixed_dt;
+}
+
 double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   StepLimit why = StepLimit::Fixed;
   const auto take = [&](double cand, double& dt, StepLimit l) {
@@ -72,7 +77,7 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   };
   if (limits_.fixed_dt > 0.0) {
     if (which) *which = why;
-    return limits_.fixed_dt;
+    return fixed_step();
   }
   constexpr double kBig = std::numeric_limits<double>::infinity();
   double dt = flow_.gammadot > 0.0 ? limits_.max_strain_step / flow_.gammadot : kBig;

@@ -39,7 +39,7 @@ bool Heun::step(Dynamics& d) {
 bool ImplicitSprings::step(Dynamics& d) {
   d.begin_step();
   const bool fixed = d.limits().fixed_dt > 0.0;
-  double dt = fixed ? d.limits().fixed_dt : next_dt_;
+  double dt = fixed ? d.fixed_step() : next_dt_;
   if (dt <= 0.0) {
     // First step: the limits evaluated on the explicit-spring velocities.
     if (!d.solve(0.0, last_)) return false;

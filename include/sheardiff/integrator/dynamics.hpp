@@ -20,6 +20,7 @@ struct StepLimits {
   double max_overlap_change = 1e-3;
   double max_strain_step = 1e-2;
   double explicit_dt = 0.0;        // stability cap of explicit springs (0 = none)
+  double end_time = 0.0;           // a fixed dt is shortened to land on it (0 = none)
 };
 
 // Which limit set a step (reported as fractions of steps in summary.json).
@@ -47,6 +48,8 @@ class Dynamics {
   bool solve(double dt_implicit, Velocities& v);
   // Largest step the limits allow for these velocities (fixed_dt if set); *which says which.
   double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
+  // fixed_dt, shortened on the last step so that a run ends exactly at limits().end_time.
+  double fixed_step() const;
   // Integrators report the limit that set each step they take.
   void count_step_limit(StepLimit l) { ++limit_counts_[static_cast<int>(l)]; }
   const std::array<long, static_cast<int>(StepLimit::Count)>& step_limit_counts() const {
