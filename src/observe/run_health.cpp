@@ -160,11 +160,12 @@ std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities
                               h, h0_, mobile_area_ / lx));
     // The step limits move the wall by ~1e-3 d per step; half a diameter in one step, or a
     // gap doubled with a gas-like packing (phi < 0.1), means it was thrown off.
-    const double jump = std::abs(v.wall_v * dt);
-    if (jump > 0.5 || (h > 2.0 * h0_ && mobile_area_ < 0.1 * lx * h))
-      return make(HealthProblem::WallEscape, d, d.walls()->top,
-                  fmt::format("top wall moved {:.3g} d in one step; gap H = {:.4g} d (initially "
-                              "{:.4g} d)",
+    const double jump = v.wall_v * dt;
+    if (std::abs(jump) > 0.5 || (h > 2.0 * h0_ && mobile_area_ < 0.1 * lx * h))
+      return make(jump < 0.0 ? HealthProblem::WallCollapse : HealthProblem::WallEscape, d,
+                  d.walls()->top,
+                  fmt::format("the top wall moved {:+.3g} d in one step (more than 0.5 d); gap "
+                              "H = {:.4g} d (initially {:.4g} d)",
                               jump, h, h0_));
     // A mobile disc beyond a wall row went through it.
     double top = 0.0, bottom = 0.0;
