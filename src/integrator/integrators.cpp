@@ -4,6 +4,10 @@
 
 namespace sheardiff {
 
+namespace {
+constexpr int kStickPasses = 4;  // re-solves per step for sliding contacts that stick
+}  // namespace
+
 bool ExplicitEuler::step(Dynamics& d) {
   d.begin_step();
   if (!d.solve(0.0, last_)) return false;
@@ -50,6 +54,15 @@ bool ImplicitSprings::step(Dynamics& d) {
   for (int attempt = 0;; ++attempt) {
     if (!d.solve(dt, last_)) return false;
     ++solves_;
+    // Sliding contacts whose explicit Coulomb force reversed their slip stick instead and the
+    // step is solved again with their tangential stiffness (a few passes: contacts only ever
+    // go from sliding to sticking here). Without this, at steps where the cap force reverses
+    // the slip by more than the cap in one step, such contacts chatter between +cap and -cap
+    // (docs/low_j.md).
+    for (int pass = 0; pass < kStickPasses && d.stick_reversed_sliding(last_) > 0; ++pass) {
+      if (!d.solve(dt, last_)) return false;
+      ++solves_;
+    }
     if (fixed) break;
     StepLimit now;
     const double allowed = d.dt_limit(last_, &now);

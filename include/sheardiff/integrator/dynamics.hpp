@@ -46,6 +46,11 @@ class Dynamics {
   void begin_step();
   // Velocities at the current configuration; dt_implicit > 0 for implicit springs.
   bool solve(double dt_implicit, Velocities& v);
+  // Implicit springs: a contact that entered the step sliding (its Coulomb force carried
+  // explicitly, no tangential stiffness) but whose solved slip v runs against its spring is not
+  // sliding in this step: it is marked sticking so that a re-solve gives it its tangential
+  // stiffness. Returns how many contacts changed (0: the sliding set is consistent with v).
+  int stick_reversed_sliding(const Velocities& v);
   // Largest step the limits allow for these velocities (fixed_dt if set); *which says which.
   double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
   // fixed_dt, shortened on the last step so that a run ends exactly at limits().end_time.
