@@ -23,7 +23,7 @@ class Simulation {
   void step();
   // One integrator step; false if the linear solve failed (the state is then unchanged).
   bool try_step() { return integrator_->step(*dynamics_); }
-  StressSample sample() const { return measure_stress(*dynamics_, integrator_->velocities(), cfg_.flow.lz); }
+  StressSample sample() const { return integrator_->sample(*dynamics_, cfg_.flow.lz); }
 
   const Config& config() const { return cfg_; }
   Dynamics& dynamics() { return *dynamics_; }

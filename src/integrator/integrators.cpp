@@ -27,10 +27,13 @@ bool Heun::step(Dynamics& d) {
   StepLimit why;
   dt_ = d.dt_limit(predictor_, &why);
   d.count_step_limit(why);
+  predictor_terms_ = d.force_balance().terms();
   const Dynamics::Saved start = d.save();
   d.advance(dt_, predictor_, /*allow_rebuild=*/false);
   const bool ok = d.solve(0.0, last_);
   ++solves_;
+  corrector_ = last_;
+  corrector_terms_ = d.force_balance().terms();
   d.restore(start);
   if (!ok) return false;
   for (std::size_t i = 0; i < last_.u.size(); ++i) last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
