@@ -38,6 +38,8 @@ bool Heun::step(Dynamics& d) {
   if (!ok) return false;
   for (std::size_t i = 0; i < last_.u.size(); ++i) last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
   last_.wall_v = 0.5 * (last_.wall_v + predictor_.wall_v);
+  // The wall load holds in the mean sample only if it held at both stages.
+  last_.wall_free_fall = last_.wall_free_fall || predictor_.wall_free_fall;
   d.advance(dt_, last_);
   d.finish_step();
   return true;
