@@ -355,6 +355,19 @@ TEST(AnalysisDilatancy, JointStandardErrorsCoverTheSlope) {
   EXPECT_GT(joint3, 0.93 * trials);
 }
 
+// Measured phi(J) (configs/sweep_2core.toml, ktilde = 1e4, docs/results.md): not an exact
+// power law, and the log-log residual has a minimum at phi_c ~ 0.81 but falls again towards
+// phi_c -> max(phi) + 0.5 (a degenerate b -> 0 fit). The fit must take the first minimum.
+TEST(AnalysisDilatancy, MeasuredSweepTakesTheFirstMinimum) {
+  const std::vector<double> j = {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 1e-1};
+  const std::vector<double> phi = {0.7961, 0.7909, 0.7795, 0.7697, 0.7383, 0.696, 0.6363};
+  const DilatancyFit f = fit_dilatancy(j, phi);
+  EXPECT_GT(f.phi_c, 0.80);
+  EXPECT_LT(f.phi_c, 0.83);
+  EXPECT_GT(f.law.b, 0.25);
+  EXPECT_LT(f.law.b, 0.6);
+}
+
 TEST(AnalysisBadInput, Throws) {
   const std::vector<double> two = {1.0, 2.0}, three = {1.0, 2.0, 3.0};
   EXPECT_THROW(fit_power_law(two, two), std::invalid_argument);
