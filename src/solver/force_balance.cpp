@@ -73,6 +73,13 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
 bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
                          const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
                          Velocities& out) {
+  assemble(p, box, flow, pairs, dt_implicit, wall);
+  return solve_assembled(p, flow, wall, out);
+}
+
+void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow& flow,
+                            const std::vector<Pair>& pairs, double dt_implicit,
+                            const WallDrive* wall) {
   if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
   if (dt_implicit > 0.0 && diagonal_only_)
     throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
@@ -86,7 +93,10 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   // Scenes without walls get a loop with no wall branch at all.
   if (wall) assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
   else assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
+}
 
+bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow,
+                                   const WallDrive* wall, Velocities& out) {
   double v = 0.0;
   bool capped = false;
   const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v,
@@ -102,7 +112,14 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   for (std::size_t i = 0; i < p.size(); ++i) {
     switch (p.motion[i]) {
       case Motion::Mobile:
-        out.u[i] = Vec3(u_[d * i], u_[d * i + 1], d == 3 ? u_[d * i + 2] : 0.0);
+        if (d == 3) {
+          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], u_[d * i + 2]);
+        } else {
+          // Without rotational unknowns only drag (and an external torque) acts on omega.
+          double w = flow.velocity(p.position[i]).z();
+          if (!p.external.empty()) w += p.external[i].z() / StokesDrag::resistance(p.radius[i]).z();
+          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], w);
+        }
         break;
       case Motion::FixedWall: out.u[i].setZero(); break;
       case Motion::FloatingWall: out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero(); break;

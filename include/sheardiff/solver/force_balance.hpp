@@ -64,6 +64,12 @@ class ForceBalance {
   bool solve(const Particles& p, const Box& box, const ShearFlow& flow,
              const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
              Velocities& out);
+  // The two halves of solve(), separately for benchmarks: pair terms and matrix, then the
+  // factorisation and back-substitution.
+  void assemble(const Particles& p, const Box& box, const ShearFlow& flow,
+                const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall);
+  bool solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
+                       Velocities& out);
 
   const std::vector<PairTerm>& terms() const { return terms_; }
   const ResistanceSystem& system() const { return system_; }
