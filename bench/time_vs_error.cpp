@@ -36,6 +36,9 @@ using namespace sheardiff;
 struct Grid {
   std::vector<double> j, ktilde, md, fixed_strain_step;
   double reference_md;
+  // Explicit springs are held at their stability limit below max displacement ~ 3e-3 d in
+  // every case of the grid, so smaller md only repeat the same run: the small grid skips them.
+  std::vector<double> explicit_md;
 };
 
 // A step-size setting: adaptive (md > 0) or fixed dt = fixed_strain_step / J.
@@ -55,23 +58,29 @@ struct Options {
   std::string cache = "bench_results/time_vs_error_cache";
   std::string out = "bench_results/time_vs_error.csv";
   bool full = false;
+  std::string scene = "pressure_shear";
+  double phi = 0.75;  // initial packing (simple_shear: the fixed area fraction)
+  double mu = 0.5;    // Coulomb friction (0: frictionless, 2 unknowns per disc)
+  double overlap = 0.0;  // > 0: max_overlap_change of every run (instead of md)
+  double gap = 0.0;      // > 0: max_gap_fraction of every run (instead of 0.5 md / 1e-3)
 };
 
 Config base_config(const Options& o, double j, double ktilde) {
   Config c;
-  c.scene.type = "pressure_shear";
+  c.scene.type = o.scene;
   c.particles.n = o.n;
-  c.particles.phi_init = 0.75;
+  c.particles.phi_init = o.phi;
   c.flow.j = j;
   c.contact.ktilde = ktilde;
   c.run.seed = o.seed;
+  c.contact.mu = o.mu;
   resolve_defaults(c);
   return c;
 }
 
 // Adaptive limits scaled together: md bounds the non-affine displacement and the overlap
 // change per step, and the gap closing fraction scales with it from its default 0.5 at 1e-3.
-void apply(Config& c, const Setting& s) {
+void apply(Config& c, const Setting& s, const Options& o) {
   c.integrator.type = s.type;
   if (s.fixed_strain_step > 0.0) {
     c.integrator.dt = s.fixed_strain_step / c.flow.j;
@@ -80,6 +89,8 @@ void apply(Config& c, const Setting& s) {
     c.integrator.max_overlap_change = s.md;
     c.integrator.max_gap_fraction = std::min(1.0, 0.5 * s.md / 1e-3);
   }
+  if (o.overlap > 0.0) c.integrator.max_overlap_change = o.overlap;
+  if (o.gap > 0.0) c.integrator.max_gap_fraction = o.gap;
 }
 
 // CPU time of this process: on a machine shared with other jobs it measures the work, where
@@ -96,7 +107,8 @@ std::string tag(double x) { return fmt::format("{:.0e}", x); }
 // the random packing, then read back from the cache.
 std::vector<char> starting_state(const Options& o, const Config& c, const Scene& scene) {
   namespace fs = std::filesystem;
-  const fs::path file = fs::path(o.cache) / fmt::format("start_N{}_J{}_k{}_seed{}_w{}.bin", o.n,
+  const fs::path file = fs::path(o.cache) / fmt::format("start_{}_phi{}_mu{}_N{}_J{}_k{}_seed{}_w{}.bin",
+                                                         o.scene, o.phi, o.mu, o.n,
                                                          tag(c.flow.j), tag(c.contact.ktilde),
                                                          o.seed, o.warmup);
   if (fs::exists(file)) {
@@ -129,7 +141,7 @@ struct Result {
 
 Result run(const Options& o, Config c, const Scene& scene, const std::vector<char>& start,
            const Setting& s) {
-  apply(c, s);
+  apply(c, s, o);
   Result r;
   r.setting = s;
   // Explicit springs need about window / (J dt_stab) steps: skip what cannot finish.
@@ -146,6 +158,7 @@ Result run(const Options& o, Config c, const Scene& scene, const std::vector<cha
   Dynamics& d = sim.dynamics();
   const Particles& p = d.particles();
   const double s0 = d.strain(), target = s0 + o.window, lx = d.box().lx * c.flow.lz;
+  const bool walls = d.walls().has_value();
   const long steps0 = d.steps();
   const auto limits0 = d.step_limit_counts();
   std::vector<Vec2> prev(p.unwrapped.begin(), p.unwrapped.begin() + p.n_mobile);
@@ -165,8 +178,9 @@ Result run(const Options& o, Config c, const Scene& scene, const std::vector<cha
       const double w = d.strain() - prev_strain;
       if (!std::isfinite(st.max_overlap) || !std::isfinite(st.top_wall_fx))
         throw std::runtime_error("non-finite state");
-      r.phi += w * PressureCellObserver::bulk_phi(d, c.observables.wall_exclusion);
-      r.mu += w * (-st.top_wall_fx / lx);
+      // Simple shear: phi is fixed and mu is the particle shear stress over the pressure.
+      r.phi += w * (walls ? PressureCellObserver::bulk_phi(d, c.observables.wall_exclusion) : c.particles.phi_init);
+      r.mu += w * (walls ? -st.top_wall_fx / lx : st.shear_stress() / st.pressure());
       r.overlap += w * st.max_overlap;
       weight += w;
       if (d.strain() >= target) {
@@ -212,6 +226,12 @@ int main(int argc, char** argv) {
   app.add_option("--max-steps", o.max_steps, "Cut (or skip) runs needing more steps");
   app.add_option("--cache", o.cache, "Folder of the cached starting states");
   app.add_option("--out", o.out, "CSV file");
+  app.add_option("--scene", o.scene, "pressure_shear (default) or simple_shear")
+      ->check(CLI::IsMember({"pressure_shear", "simple_shear"}));
+  app.add_option("--mu", o.mu, "Coulomb friction coefficient");
+  app.add_option("--overlap", o.overlap, "Fix max_overlap_change (d) in every run");
+  app.add_option("--gap", o.gap, "Fix max_gap_fraction in every run");
+  app.add_option("--phi", o.phi, "Initial area fraction (simple_shear: the fixed one)");
   std::vector<double> only_j, only_k, only_md, only_fixed;
   std::vector<std::string> only_types;
   app.add_option("--J", only_j, "Override the J values");
@@ -225,13 +245,14 @@ int main(int argc, char** argv) {
 
   Grid g;
   if (o.full) {
-    g = {{1e-1, 1e-2, 1e-3, 1e-4}, {1e3, 1e4, 1e5}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4, 1e-5}, 1e-4};
+    g = {{1e-1, 1e-2, 1e-3, 1e-4}, {1e3, 1e4, 1e5}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4, 1e-5}, 1e-4,
+         {3e-3, 1e-3, 3e-4}};
   } else {
-    g = {{1e-2, 1e-3}, {1e4}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4}, 1e-4};
+    g = {{1e-2, 1e-3}, {1e4}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4}, 1e-4, {1e-3}};
   }
   if (!only_j.empty()) g.j = only_j;
   if (!only_k.empty()) g.ktilde = only_k;
-  if (!only_md.empty()) g.md = only_md;
+  if (!only_md.empty()) g.md = g.explicit_md = only_md;
   if (!only_fixed.empty()) {
     g.fixed_strain_step.clear();
     for (double f : only_fixed)
@@ -252,7 +273,7 @@ int main(int argc, char** argv) {
                                           ? "."
                                           : std::filesystem::path(o.out).parent_path());
   std::ofstream csv(o.out);
-  csv << "N,J,ktilde,integrator,policy,md,strain_step,window,status,steps,steps_per_strain,"
+  csv << "scene,mu,N,J,ktilde,integrator,policy,md,strain_step,window,status,steps,steps_per_strain,"
          "wall_s,wall_s_per_strain,ms_per_step,cpu_s_per_strain,cpu_ms_per_step,rms_dev,phi,mu,max_overlap,phi_err,mu_err,"
          "overlap_rel_err,limited_by\n";
   for (double ktilde : g.ktilde) {
@@ -263,7 +284,8 @@ int main(int argc, char** argv) {
       std::vector<Setting> settings;
       settings.push_back({IntegratorType::Implicit, g.reference_md, 0.0, true});
       for (IntegratorType t : types) {
-        for (double md : g.md) settings.push_back({t, md, 0.0, false});
+        for (double md : t == IntegratorType::Implicit ? g.md : g.explicit_md)
+          settings.push_back({t, md, 0.0, false});
         for (double fs : g.fixed_strain_step) settings.push_back({t, 0.0, fs, false});
       }
       std::optional<Result> ref;
@@ -274,9 +296,9 @@ int main(int argc, char** argv) {
         const double rms = ok && ref ? rms_deviation(r.end, ref->end) : NAN;
         const std::string policy = s.reference ? "reference" : s.fixed_strain_step > 0 ? "fixed" : "adaptive";
         const std::string row = fmt::format(
-            "{},{:g},{:g},{},{},{:g},{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.8g},{:.8g},"
+            "{},{:g},{},{:g},{:g},{},{},{:g},{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.8g},{:.8g},"
             "{:.6g},{:.6g},{:.6g},{:.6g},{}",
-            o.n, j, ktilde, to_string(s.type), policy, s.md, s.fixed_strain_step, o.window,
+            o.scene, o.mu, o.n, j, ktilde, to_string(s.type), policy, s.md, s.fixed_strain_step, o.window,
             r.status, r.steps, r.strain > 0 ? r.steps / r.strain : NAN,
             r.wall, r.strain > 0 ? r.wall / r.strain : NAN, r.steps ? 1e3 * r.wall / r.steps : NAN,
             r.strain > 0 ? r.cpu / r.strain : NAN, r.steps ? 1e3 * r.cpu / r.steps : NAN,
