@@ -5,6 +5,7 @@ and against |mu - mu_ref| (bottom row); each integrator's Pareto front is drawn 
 
     /usr/bin/python3 tools/plot_time_vs_error.py bench_results/time_vs_error.csv \
         docs/figures/time_vs_error.png
+    /usr/bin/python3 tools/plot_time_vs_error.py --table bench_results/time_vs_error.csv
 """
 import csv
 import math
@@ -65,5 +66,29 @@ def main(path, out):
     print(out)
 
 
+def table(path):
+    """The CSV as a markdown table (docs/performance.md)."""
+    print("| J | ktilde | integrator | step policy | steps / strain | CPU s / strain | rms dev (d) "
+          "| phi - ref | mu - ref | max overlap rel. | limited by |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in csv.DictReader(open(path)):
+        if r["policy"] == "reference":
+            policy = f"reference, md {float(r['md']):g}"
+        elif r["policy"] == "adaptive":
+            policy = f"md {float(r['md']):g}"
+        else:
+            policy = f"fixed J dt = {float(r['strain_step']):g}"
+        if r["status"] != "ok":
+            print(f"| {r['J']} | {r['ktilde']} | {r['integrator']} | {policy} | {r['status']} |||||||")
+            continue
+        f = lambda k, fmt: format(float(r[k]), fmt)
+        print(f"| {r['J']} | {r['ktilde']} | {r['integrator']} | {policy} | {f('steps_per_strain', '.0f')} "
+              f"| {f('cpu_s_per_strain', '.3g')} | {f('rms_dev', '.2g')} | {f('phi_err', '+.1e')} "
+              f"| {f('mu_err', '+.3f')} | {f('overlap_rel_err', '+.2f')} | {r['limited_by']} |")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/figures/time_vs_error.png")
+    if sys.argv[1] == "--table":
+        table(sys.argv[2])
+    else:
+        main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/figures/time_vs_error.png")
