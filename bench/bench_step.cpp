@@ -22,11 +22,11 @@ using sheardiff::Config;
 using sheardiff::Simulation;
 
 enum Variant : int {
-  kFrictional = 0,      // the default engine: mu = 0.5, 3 unknowns per particle
-  kFrictionless2 = 1,   // mu = 0, tangential lubrication off: 2 unknowns per particle
-  kFrictionless3 = 2,   // the same physics keeping the rotational unknowns
-  kNoLubrication = 3,   // no lubrication, explicit Euler springs: diagonal system
-  kPressureCell = 4,    // pressure_shear, floating wall (bordered system)
+  kFrictional = 0,     // the default engine: mu = 0.5, 3 unknowns per particle
+  kFrictionless2 = 1,  // mu = 0, tangential lubrication off: 2 unknowns per particle
+  kFrictionless3 = 2,  // the same physics keeping the rotational unknowns
+  kNoLubrication = 3,  // no lubrication, explicit Euler springs: diagonal system
+  kPressureCell = 4,   // pressure_shear, floating wall (bordered system)
 };
 constexpr const char* kVariantNames[] = {"frictional", "frictionless_2dof", "frictionless_3dof",
                                          "no_lubrication_euler", "pressure_cell"};
@@ -52,7 +52,8 @@ Config config_of(int n, int variant) {
       cfg.scene.type = "pressure_shear";
       cfg.particles.phi_init = 0.75;
       break;
-    default: break;
+    default:
+      break;
   }
   return cfg;
 }
@@ -162,8 +163,7 @@ void sizes(benchmark::internal::Benchmark* b) {
 }
 void variants(benchmark::internal::Benchmark* b) {
   for (int n : {250, 1000, 4000}) b->Args({n, kFrictional});
-  for (int v : {kFrictionless2, kFrictionless3, kNoLubrication, kPressureCell})
-    b->Args({1000, v});
+  for (int v : {kFrictionless2, kFrictionless3, kNoLubrication, kPressureCell}) b->Args({1000, v});
   b->Unit(benchmark::kMillisecond);
 }
 

@@ -11,10 +11,10 @@
 //
 //   OMP_THREAD_LIMIT=1 build/bench/time_vs_error --out bench_results/time_vs_error.csv
 //   OMP_THREAD_LIMIT=1 build/bench/time_vs_error --full --out bench_results/time_vs_error_full.csv
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <time.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -52,15 +52,15 @@ struct Setting {
 struct Options {
   std::int64_t n = 250;
   std::int64_t seed = 1;
-  double warmup = 1.0;   // strain before the starting state
-  double window = 0.1;   // strain of each compared run
+  double warmup = 1.0;     // strain before the starting state
+  double window = 0.1;     // strain of each compared run
   double max_steps = 4e5;  // runs predicted (explicit) or found to need more are cut
   std::string cache = "bench_results/time_vs_error_cache";
   std::string out = "bench_results/time_vs_error.csv";
   bool full = false;
   std::string scene = "pressure_shear";
-  double phi = 0.75;  // initial packing (simple_shear: the fixed area fraction)
-  double mu = 0.5;    // Coulomb friction (0: frictionless, 2 unknowns per disc)
+  double phi = 0.75;     // initial packing (simple_shear: the fixed area fraction)
+  double mu = 0.5;       // Coulomb friction (0: frictionless, 2 unknowns per disc)
   double overlap = 0.0;  // > 0: max_overlap_change of every run (instead of md)
   double gap = 0.0;      // > 0: max_gap_fraction of every run (instead of 0.5 md / 1e-3)
 };
@@ -101,16 +101,18 @@ double cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-std::string tag(double x) { return fmt::format("{:.0e}", x); }
+std::string tag(double x) {
+  return fmt::format("{:.0e}", x);
+}
 
 // The starting state of (J, ktilde): made once by an implicit run over the warm-up strain from
 // the random packing, then read back from the cache.
 std::vector<char> starting_state(const Options& o, const Config& c, const Scene& scene) {
   namespace fs = std::filesystem;
-  const fs::path file = fs::path(o.cache) / fmt::format("start_{}_phi{}_mu{}_N{}_J{}_k{}_seed{}_w{}.bin",
-                                                         o.scene, o.phi, o.mu, o.n,
-                                                         tag(c.flow.j), tag(c.contact.ktilde),
-                                                         o.seed, o.warmup);
+  const fs::path file =
+      fs::path(o.cache) / fmt::format("start_{}_phi{}_mu{}_N{}_J{}_k{}_seed{}_w{}.bin", o.scene,
+                                      o.phi, o.mu, o.n, tag(c.flow.j), tag(c.contact.ktilde),
+                                      o.seed, o.warmup);
   if (fs::exists(file)) {
     std::ifstream in(file, std::ios::binary);
     return std::vector<char>(std::istreambuf_iterator<char>(in), {});
@@ -121,11 +123,12 @@ std::vector<char> starting_state(const Options& o, const Config& c, const Scene&
   Archive a = Archive::writer();
   sim.dynamics().serialize(a);
   fs::create_directories(file.parent_path());
-  std::ofstream(file, std::ios::binary).write(a.bytes().data(), static_cast<std::streamsize>(a.bytes().size()));
-  std::cerr << fmt::format("  starting state J={} ktilde={}: {} steps, {:.1f} s -> {}\n",
-                           c.flow.j, c.contact.ktilde, sim.dynamics().steps(),
-                           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                           file.string());
+  std::ofstream(file, std::ios::binary)
+      .write(a.bytes().data(), static_cast<std::streamsize>(a.bytes().size()));
+  std::cerr << fmt::format(
+      "  starting state J={} ktilde={}: {} steps, {:.1f} s -> {}\n", c.flow.j, c.contact.ktilde,
+      sim.dynamics().steps(),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), file.string());
   return a.bytes();
 }
 
@@ -146,7 +149,8 @@ Result run(const Options& o, Config c, const Scene& scene, const std::vector<cha
   r.setting = s;
   // Explicit springs need about window / (J dt_stab) steps: skip what cannot finish.
   if (c.integrator.type != IntegratorType::Implicit && s.fixed_strain_step == 0.0) {
-    const double est = o.window / (c.flow.j * c.integrator.explicit_safety * explicit_stability_dt(c));
+    const double est =
+        o.window / (c.flow.j * c.integrator.explicit_safety * explicit_stability_dt(c));
     if (est > o.max_steps) {
       r.status = fmt::format("skipped: ~{:.2g} steps", est);
       return r;
@@ -179,14 +183,16 @@ Result run(const Options& o, Config c, const Scene& scene, const std::vector<cha
       if (!std::isfinite(st.max_overlap) || !std::isfinite(st.top_wall_fx))
         throw std::runtime_error("non-finite state");
       // Simple shear: phi is fixed and mu is the particle shear stress over the pressure.
-      r.phi += w * (walls ? PressureCellObserver::bulk_phi(d, c.observables.wall_exclusion) : c.particles.phi_init);
+      r.phi += w * (walls ? PressureCellObserver::bulk_phi(d, c.observables.wall_exclusion)
+                          : c.particles.phi_init);
       r.mu += w * (walls ? -st.top_wall_fx / lx : st.shear_stress() / st.pressure());
       r.overlap += w * st.max_overlap;
       weight += w;
       if (d.strain() >= target) {
         const double f = (target - prev_strain) / (d.strain() - prev_strain);
         r.end.resize(p.n_mobile);
-        for (std::size_t i = 0; i < p.n_mobile; ++i) r.end[i] = prev[i] + f * (p.unwrapped[i] - prev[i]);
+        for (std::size_t i = 0; i < p.n_mobile; ++i)
+          r.end[i] = prev[i] + f * (p.unwrapped[i] - prev[i]);
       } else {
         std::copy(p.unwrapped.begin(), p.unwrapped.begin() + p.n_mobile, prev.begin());
         prev_strain = d.strain();
@@ -201,7 +207,9 @@ Result run(const Options& o, Config c, const Scene& scene, const std::vector<cha
   long best = -1;
   for (int k = 0; k < static_cast<int>(StepLimit::Count); ++k) {
     const long n = d.step_limit_counts()[k] - limits0[k];
-    if (n > best) best = n, r.limited_by = fmt::format("{} {:.0f}%", to_string(static_cast<StepLimit>(k)), 100.0 * n / std::max(1L, r.steps));
+    if (n > best)
+      best = n, r.limited_by = fmt::format("{} {:.0f}%", to_string(static_cast<StepLimit>(k)),
+                                           100.0 * n / std::max(1L, r.steps));
   }
   return r;
 }
@@ -264,7 +272,7 @@ int main(int argc, char** argv) {
   if (!only_types.empty()) {
     types.clear();
     for (const auto& t : only_types)
-      types.push_back(t == "euler" ? IntegratorType::Euler
+      types.push_back(t == "euler"  ? IntegratorType::Euler
                       : t == "heun" ? IntegratorType::Heun
                                     : IntegratorType::Implicit);
   }
@@ -273,8 +281,10 @@ int main(int argc, char** argv) {
                                           ? "."
                                           : std::filesystem::path(o.out).parent_path());
   std::ofstream csv(o.out);
-  csv << "scene,mu,N,J,ktilde,integrator,policy,md,strain_step,window,status,steps,steps_per_strain,"
-         "wall_s,wall_s_per_strain,ms_per_step,cpu_s_per_strain,cpu_ms_per_step,rms_dev,phi,mu,max_overlap,phi_err,mu_err,"
+  csv << "scene,mu,N,J,ktilde,integrator,policy,md,strain_step,window,status,steps,steps_per_"
+         "strain,"
+         "wall_s,wall_s_per_strain,ms_per_step,cpu_s_per_strain,cpu_ms_per_step,rms_dev,phi,mu,max_"
+         "overlap,phi_err,mu_err,"
          "overlap_rel_err,limited_by\n";
   for (double ktilde : g.ktilde) {
     for (double j : g.j) {
@@ -294,17 +304,19 @@ int main(int argc, char** argv) {
         if (s.reference) ref = r;
         const bool ok = r.status == "ok";
         const double rms = ok && ref ? rms_deviation(r.end, ref->end) : NAN;
-        const std::string policy = s.reference ? "reference" : s.fixed_strain_step > 0 ? "fixed" : "adaptive";
+        const std::string policy = s.reference               ? "reference"
+                                   : s.fixed_strain_step > 0 ? "fixed"
+                                                             : "adaptive";
         const std::string row = fmt::format(
-            "{},{:g},{},{:g},{:g},{},{},{:g},{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.8g},{:.8g},"
+            "{},{:g},{},{:g},{:g},{},{},{:g},{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:."
+            "6g},{:.6g},{:.8g},{:.8g},"
             "{:.6g},{:.6g},{:.6g},{:.6g},{}",
-            o.scene, o.mu, o.n, j, ktilde, to_string(s.type), policy, s.md, s.fixed_strain_step, o.window,
-            r.status, r.steps, r.strain > 0 ? r.steps / r.strain : NAN,
-            r.wall, r.strain > 0 ? r.wall / r.strain : NAN, r.steps ? 1e3 * r.wall / r.steps : NAN,
-            r.strain > 0 ? r.cpu / r.strain : NAN, r.steps ? 1e3 * r.cpu / r.steps : NAN,
-            rms, ok ? r.phi : NAN, ok ? r.mu : NAN, ok ? r.overlap : NAN,
-            ok ? r.phi - ref->phi : NAN, ok ? r.mu - ref->mu : NAN,
-            ok ? r.overlap / ref->overlap - 1.0 : NAN, r.limited_by);
+            o.scene, o.mu, o.n, j, ktilde, to_string(s.type), policy, s.md, s.fixed_strain_step,
+            o.window, r.status, r.steps, r.strain > 0 ? r.steps / r.strain : NAN, r.wall,
+            r.strain > 0 ? r.wall / r.strain : NAN, r.steps ? 1e3 * r.wall / r.steps : NAN,
+            r.strain > 0 ? r.cpu / r.strain : NAN, r.steps ? 1e3 * r.cpu / r.steps : NAN, rms,
+            ok ? r.phi : NAN, ok ? r.mu : NAN, ok ? r.overlap : NAN, ok ? r.phi - ref->phi : NAN,
+            ok ? r.mu - ref->mu : NAN, ok ? r.overlap / ref->overlap - 1.0 : NAN, r.limited_by);
         csv << row << "\n" << std::flush;
         std::cerr << row << "\n";
       }

@@ -95,8 +95,8 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow&
   else assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
 }
 
-bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow,
-                                   const WallDrive* wall, Velocities& out) {
+bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
+                                   Velocities& out) {
   double v = 0.0;
   bool capped = false;
   const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v,

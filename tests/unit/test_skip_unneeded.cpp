@@ -50,7 +50,8 @@ void expect_same_trajectory(Config c, IntegratorType type, int steps) {
     max_overlap = std::max(max_overlap, two.sample().max_overlap);
   }
   EXPECT_GT(max_overlap, 0.0) << "the test should exercise contacts";
-  EXPECT_NEAR(two.dynamics().strain(), three.dynamics().strain(), 1e-12 * three.dynamics().strain());
+  EXPECT_NEAR(two.dynamics().strain(), three.dynamics().strain(),
+              1e-12 * three.dynamics().strain());
   // Positions are O(10 d); round-off amplified over a few hundred steps stays far below 1e-9 d.
   EXPECT_LT(max_position_difference(two.dynamics(), three.dynamics()), 1e-9);
   // omega = omega_inf for every mobile particle: what the decoupled rotational row gives.
@@ -139,7 +140,8 @@ TEST(SkipUnneeded, RebuildOnlyWhenTheSkinIsUsedUp) {
     // A rebuild happens at the step after the skin was used up, and only then; the symbolic
     // analysis follows the rebuilds one to one.
     EXPECT_EQ(rebuilt, due) << "step " << k;
-    EXPECT_EQ(d.force_balance().system().analyses() - analyses, d.neighbours().rebuilds() - rebuilds);
+    EXPECT_EQ(d.force_balance().system().analyses() - analyses,
+              d.neighbours().rebuilds() - rebuilds);
     rebuild_steps += rebuilt;
     rebuilds = d.neighbours().rebuilds();
     analyses = d.force_balance().system().analyses();
