@@ -256,7 +256,7 @@ int main(int argc, char** argv) {
     g = {{1e-1, 1e-2, 1e-3, 1e-4}, {1e3, 1e4, 1e5}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4, 1e-5}, 1e-4,
          {3e-3, 1e-3, 3e-4}};
   } else {
-    g = {{1e-2, 1e-3}, {1e4}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4}, 1e-4, {1e-3}};
+    g = {{1e-2, 1e-3, 1e-4}, {1e4}, {3e-3, 1e-3, 3e-4}, {1e-3, 1e-4}, 1e-4, {1e-3}};
   }
   if (!only_j.empty()) g.j = only_j;
   if (!only_k.empty()) g.ktilde = only_k;
