@@ -44,6 +44,7 @@ struct KeySpec {
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
   bool lo_open = false;  // lo excluded
+  bool hi_open = false;  // hi excluded
   std::vector<std::string> choices;
   std::string unit;
   std::string doc;
@@ -55,8 +56,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 template <typename T>
 KeySpec real(std::string key, T Config::*sec, double T::*field, double lo, double hi, bool lo_open,
-             std::string unit, std::string doc) {
-  KeySpec k{std::move(key), Kind::Real, lo, hi, lo_open, {}, std::move(unit), std::move(doc), {}, {}};
+             std::string unit, std::string doc, bool hi_open = false) {
+  KeySpec k{std::move(key), Kind::Real, lo, hi, lo_open, hi_open, {}, std::move(unit),
+            std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<double>(v); };
   return k;
@@ -64,21 +66,21 @@ KeySpec real(std::string key, T Config::*sec, double T::*field, double lo, doubl
 template <typename T>
 KeySpec integer(std::string key, T Config::*sec, std::int64_t T::*field, double lo, double hi,
                 std::string unit, std::string doc) {
-  KeySpec k{std::move(key), Kind::Integer, lo, hi, false, {}, std::move(unit), std::move(doc), {}, {}};
+  KeySpec k{std::move(key), Kind::Integer, lo, hi, false, false, {}, std::move(unit), std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::int64_t>(v); };
   return k;
 }
 template <typename T>
 KeySpec boolean(std::string key, T Config::*sec, bool T::*field, std::string doc) {
-  KeySpec k{std::move(key), Kind::Boolean, -kInf, kInf, false, {}, "", std::move(doc), {}, {}};
+  KeySpec k{std::move(key), Kind::Boolean, -kInf, kInf, false, false, {}, "", std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<bool>(v); };
   return k;
 }
 template <typename T>
 KeySpec text(std::string key, T Config::*sec, std::string T::*field, std::string doc) {
-  KeySpec k{std::move(key), Kind::Text, -kInf, kInf, false, {}, "", std::move(doc), {}, {}};
+  KeySpec k{std::move(key), Kind::Text, -kInf, kInf, false, false, {}, "", std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::string>(v); };
   return k;
@@ -86,7 +88,7 @@ KeySpec text(std::string key, T Config::*sec, std::string T::*field, std::string
 KeySpec choice(std::string key, std::vector<std::string> choices, std::string doc,
                std::function<Value(const Config&)> get,
                std::function<void(Config&, const Value&)> set) {
-  return KeySpec{std::move(key), Kind::Choice, -kInf, kInf, false, std::move(choices), "",
+  return KeySpec{std::move(key), Kind::Choice, -kInf, kInf, false, false, std::move(choices), "",
                  std::move(doc), std::move(get), std::move(set)};
 }
 
@@ -137,7 +139,8 @@ const std::vector<KeySpec>& schema() {
                      "1 (reduced gap)", "Regularisation of the lubrication singularity."));
     s.push_back(real("lubrication.h_max", &C::lubrication, &C::Lubrication::h_max, 0.0, 1.0, true,
                      "1 (reduced gap)",
-                     "Lubrication cut-off: active for 0 < h < h_max (must be < 1)."));
+                     "Lubrication cut-off: active for 0 < h < h_max (must be < 1).",
+                     /*hi_open=*/true));
     s.push_back(boolean("lubrication.tangential", &C::lubrication, &C::Lubrication::tangential,
                         "Tangential lubrication modes (shear, shear-rotation, pump); off = squeeze "
                         "only. Off with mu = 0: no rotational unknowns (2 per particle)."));
@@ -247,6 +250,15 @@ const std::vector<KeySpec>& schema() {
                      "a frame); 0 = only on SIGINT/SIGTERM. Resume with --resume DIR."));
     s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
                         "Write DIR/trajectory.h5 (summary.json is always written)."));
+    s.push_back(real("health.max_overlap", &C::health, &C::Health::max_overlap, 0.0, 1.0, true,
+                     "d",
+                     "Run health: stop the run (exit 4) when a contact overlaps by more. The "
+                     "mean overlap is ~1/ktilde d, so 0.1 d is 10x it at ktilde = 1e2 and 1000x "
+                     "at the default 1e4: only a broken step gets there (docs/stability.md)."));
+    s.push_back(real("health.max_residual", &C::health, &C::Health::max_residual, 0.0, 1.0, true,
+                     "1",
+                     "Run health: stop the run (exit 4) when the relative residual of the force "
+                     "balance solve, |A U - F| / |F|, exceeds this."));
     return s;
   }();
   return specs;
@@ -271,6 +283,21 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 std::string suggestion(const std::string& key) {
+  // A known name put in the wrong section: the same name elsewhere beats any spelling match.
+  {
+    const auto dot = key.find('.');
+    const std::string name = dot == std::string::npos ? "." + key : key.substr(dot);
+    std::vector<std::string> same;
+    for (const auto& k : schema())
+      if (k.key.size() > name.size() && k.key.ends_with(name) &&
+          k.key.find('.') == k.key.size() - name.size())
+        same.push_back("'" + k.key + "'");
+    if (!same.empty()) {
+      std::string list = same[0];
+      for (std::size_t i = 1; i < same.size(); ++i) list += " or " + same[i];
+      return fmt::format(" (did you mean {}?)", list);
+    }
+  }
   std::string best;
   std::size_t best_d = 4;
   for (const auto& k : schema()) {
@@ -291,7 +318,8 @@ std::string range_text(const KeySpec& k) {
     }
     case Kind::Integer: return fmt::format("an integer in [{:g}, {:g}]", k.lo, k.hi);
     case Kind::Real:
-      return fmt::format("a number in {}{:g}, {:g}]", k.lo_open ? "(" : "[", k.lo, k.hi);
+      return fmt::format("a number in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo, k.hi,
+                         k.hi_open ? ")" : "]");
   }
   return "";
 }
@@ -303,6 +331,13 @@ std::string range_text(const KeySpec& k) {
 std::string describe(const toml::node& n) {
   std::ostringstream os;
   if (n.is_string()) os << '"' << *n.value<std::string>() << '"';
+  // Shortest form that reads back exactly: -0.1, not -0.10000000000000001.
+  else if (n.is_floating_point()) {
+    std::string t = fmt::format("{}", *n.value<double>());
+    // Kept recognisable as a TOML float: 2.0, not 2.
+    if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
+    os << t;
+  }
   else if (n.is_table()) os << "a table";
   else if (n.is_array()) os << "an array";
   else n.visit([&](const auto& v) { os << v; });
@@ -339,7 +374,7 @@ Value convert(const toml::node& node, const KeySpec& k, const std::string& origi
   if (k.kind == Kind::Real || k.kind == Kind::Integer) {
     const double x = k.kind == Kind::Real ? std::get<double>(v)
                                           : static_cast<double>(std::get<std::int64_t>(v));
-    if (x < k.lo || x > k.hi || (k.lo_open && x == k.lo)) bad();
+    if (x < k.lo || x > k.hi || (k.lo_open && x == k.lo) || (k.hi_open && x == k.hi)) bad();
   }
   if (k.kind == Kind::Choice &&
       std::find(k.choices.begin(), k.choices.end(), std::get<std::string>(v)) == k.choices.end())

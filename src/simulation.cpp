@@ -16,6 +16,8 @@
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
+#include "sheardiff/observe/run_health.hpp"
+#include "sheardiff/setup/random_packing.hpp"
 #include <functional>
 
 namespace sheardiff {
@@ -59,6 +61,29 @@ bool rotational_unknowns(const Config& cfg) {
   return contact_of(cfg).has_friction() || tangential_lubrication;
 }
 
+void validate_run_inputs(const Config& cfg, const std::string& origin) {
+  if (cfg.integrator.type != IntegratorType::Implicit && cfg.integrator.dt > 0.0) {
+    const double limit = explicit_stability_dt(cfg);
+    if (cfg.integrator.dt >= limit)
+      throw ConfigError(fmt::format(
+          "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
+          "eta/P of explicit springs (smallest pair, normal and slip modes, "
+          "model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < {:.3g}, integrator.dt = 0 (adaptive), or "
+          "integrator.type = \"implicit\"",
+          origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
+          limit));
+  }
+  if (!cfg.particles.init_file.empty()) {
+    try {
+      (void)initial_packing(cfg);
+    } catch (const ConfigError& e) {
+      throw ConfigError(fmt::format("{}: {}", origin, e.what()));
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
+    }
+  }
+}
+
 Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
 
 Simulation::Simulation(const Config& cfg, Scene scene)
@@ -69,6 +94,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.max_gap_fraction = cfg.integrator.max_gap_fraction;
   lim.max_overlap_change = cfg.integrator.max_overlap_change;
   lim.max_strain_step = cfg.integrator.max_strain_step;
+  lim.end_time = cfg.run.strain / cfg.flow.j;
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
@@ -143,7 +169,8 @@ struct StopSignals {
   }
 };
 
-constexpr const char* kCheckpointMagic = "sheardiff-checkpoint-1";
+// 2: the run health state was added.
+constexpr const char* kCheckpointMagic = "sheardiff-checkpoint-2";
 
 std::vector<char> read_bytes(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -176,16 +203,21 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     if (!std::filesystem::exists(checkpoint_file))
       throw ConfigError(fmt::format("--resume {}: no checkpoint.bin there", out_dir.string()));
     checkpoint = read_bytes(checkpoint_file);
-  } else {
-    std::filesystem::create_directories(out_dir);
-    std::filesystem::remove(checkpoint_file);
-    std::filesystem::remove(out_dir / "summary.json");
-    write_text_atomically(out_dir / "config.toml", resolved);
   }
-
+  // The initial state is built before anything is written: a bad input file leaves no output.
   Simulation sim(cfg);
   Dynamics& d = sim.dynamics();
   const Particles& p = d.particles();
+  // The residual is one sparse product per solve, small next to the factorisation.
+  d.force_balance().set_check_residual(true);
+  RunHealth health(cfg, d);
+  if (!resume) {
+    std::filesystem::create_directories(out_dir);
+    std::filesystem::remove(checkpoint_file);
+    std::filesystem::remove(out_dir / "summary.json");
+    std::filesystem::remove(out_dir / "diagnostic.txt");
+    write_text_atomically(out_dir / "config.toml", resolved);
+  }
   auto observers = make_observers(cfg, out_dir);
 
   double next_frame = cfg.output.frame_strain;
@@ -205,6 +237,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     d.serialize(a);
     sim.serialize_integrator(a);
     for (auto& o : observers) o->serialize(a);
+    health.serialize(a);
     a.io(next_frame), a.io(next_checkpoint), a.io(elapsed_before), a.io(frames);
   };
   if (resume) {
@@ -257,6 +290,14 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     return d.strain() >= cfg.run.strain * (1.0 - 1e-12) ||
            (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
   };
+  // A run gone wrong stops with a checkpoint if its state is finite (else the last one is
+  // kept) and a diagnostic frame.
+  const auto stop = [&](const HealthReport& r) {
+    if (r.state_finite) save_checkpoint(seconds());
+    write_diagnostic(out_dir / "diagnostic.txt", d, sim.integrator().velocities(), r);
+    if (tty) std::fprintf(stderr, "\n");
+    throw RunUnhealthy(r);
+  };
   while (!finished()) {
     if (const int sig = g_stop_signal.load()) {
       save_checkpoint(seconds());
@@ -265,7 +306,9 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
           "stopped by signal {} at step {} (strain {:.6g}); checkpoint written: resume with "
           "`sheardiff run CONFIG --resume {}`", sig, d.steps(), d.strain(), out_dir.string()));
     }
-    sim.step();
+    if (!sim.try_step()) stop(health.solver_failure(d, sim.integrator().velocities()));
+    if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+      stop(*r);
     const StressSample s = sim.sample();
     const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
     for (const auto& o : observers) o->on_step(view);
@@ -309,6 +352,12 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
       last_flush = now;
     }
   }
+  // The last move may have used up the skin: check it against a fresh neighbour list.
+  if (d.neighbours().needs_rebuild()) {
+    d.rebuild_now();
+    if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+      stop(*r);
+  }
   if (tty) std::fprintf(stderr, "\n");
   const double wall = elapsed_before + seconds();
 
@@ -338,6 +387,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   js["lx"] = d.box().lx;
   js["ly"] = d.height();
   for (const auto& o : observers) o->finish(d, js, writer.get());
+  health.report(js);
   if (!js.contains("phi")) {
     double area = 0;
     for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];

@@ -15,10 +15,14 @@ and the run exits with code 2. Any key can be overridden from the command line w
 Units are those of `docs/units.md`: d (small diameter) = 1, P = 1, eta = 1, so gammadot = J and
 kn = ktilde.
 
-Exit codes of `sheardiff`: 0 finished, 2 invalid configuration or input file, 3 the run
-failed numerically (linear solve not positive definite, non-finite velocities), 130 / 143
-stopped by SIGINT / SIGTERM after writing `DIR/checkpoint.bin` (continue with
-`sheardiff run CONFIG --resume DIR`), 1 other errors (I/O).
+Exit codes of `sheardiff`: 0 finished, 2 invalid configuration or input file (found before
+any output is written, by `sheardiff check` too), 4 stopped by a run health check (non-finite
+state, overlap above `health.max_overlap`, failed linear solve, residual above
+`health.max_residual`, wall thrown off or collapsed: the message says what, where and which key
+to change; `DIR/diagnostic.txt` holds the last frame, `DIR/checkpoint.bin` the state if it is
+finite), 3 other numerical failures, 130 / 143 stopped by SIGINT / SIGTERM after writing
+`DIR/checkpoint.bin` (continue with `sheardiff run CONFIG --resume DIR`), 1 other errors (I/O).
+See `docs/stability.md`.
 
 A run directory is finished when it holds `summary.json` (written last, atomically); a
 directory with `checkpoint.bin` and no `summary.json` is an interrupted run that `--resume`

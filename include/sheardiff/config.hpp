@@ -90,6 +90,10 @@ struct Config {
     bool trajectory = true;
     double checkpoint_strain = 1.0;  // 0 = no periodic checkpoints
   } output;
+  struct Health {
+    double max_overlap = 0.1;    // d: a run with a larger contact overlap is stopped
+    double max_residual = 1e-6;  // relative residual of the force balance solve
+  } health;
 };
 
 // Thrown for any invalid configuration; what() names the file, the key and the allowed range.

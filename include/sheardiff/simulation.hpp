@@ -22,7 +22,9 @@ class Simulation {
 
   // One integrator step; throws std::runtime_error if the linear solve fails.
   void step();
-  StressSample sample() const { return measure_stress(*dynamics_, integrator_->velocities(), cfg_.flow.lz); }
+  // One integrator step; false if the linear solve failed (the state is then unchanged).
+  bool try_step() { return integrator_->step(*dynamics_); }
+  StressSample sample() const { return integrator_->sample(*dynamics_, cfg_.flow.lz); }
 
   const Config& config() const { return cfg_; }
   Dynamics& dynamics() { return *dynamics_; }
@@ -46,6 +48,12 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
 
 // Whether the run needs the rotational unknowns (3 per particle) or only translation (2).
 bool rotational_unknowns(const Config& cfg);
+
+// The checks of a configuration that need the physics or input files (parse_config does the
+// rest): a fixed dt of explicit springs below their stability limit, and particles.init_file
+// readable with particles.N mobile particles. Throws ConfigError naming origin and the key.
+// Writes nothing: `sheardiff check` and `run` call it before any output exists.
+void validate_run_inputs(const Config& cfg, const std::string& origin);
 
 // A run stopped by SIGINT/SIGTERM after writing its checkpoint.
 struct RunInterrupted : std::runtime_error {

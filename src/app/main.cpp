@@ -1,22 +1,101 @@
 // Command line of sheardiff: run a config, validate one, or print the config reference.
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <unistd.h>
 #include <iostream>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
+#include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/simulation.hpp"
-#include <cmath>
+#include "sheardiff/sweep/sweep.hpp"
 
 namespace {
-// Exit codes (docs/config.md): 0 done, 2 invalid config or input, 3 the run failed numerically,
-// 1 anything else (I/O).
+// Exit codes (README, docs/stability.md): 0 done, 2 invalid config or input, 3 the run failed
+// numerically outside the step loop, 4 stopped by a run health check (kExitUnhealthy), 1
+// anything else (I/O), 128 + signal after SIGINT/SIGTERM.
 constexpr int kExitConfig = 2;
 constexpr int kExitNumerical = 3;
+int run_sweep(const std::string& file, const std::filesystem::path& out, int jobs,
+              std::string backend, long point, bool collect_only) {
+  namespace sd = sheardiff;
+  const auto spec = sd::load_sweep(file);
+  if (backend.empty()) backend = spec.backend;
+  if (point >= 0) {
+    const auto points = sd::expand_points(spec);
+    if (point >= static_cast<long>(points.size()))
+      throw sd::ConfigError(
+          fmt::format("--point {}: the sweep has points 0 to {}", point, points.size() - 1));
+    const auto& p = points[point];
+    // A failure is recorded next to the log, so that sweep.csv can say which point failed how.
+    const auto marker = out / "logs" / (p.name + ".failed");
+    std::filesystem::create_directories(out / "logs");
+    std::filesystem::remove(marker);
+    try {
+      sd::run_point(spec, p, out);
+      return 0;
+    } catch (const sd::RunInterrupted&) {
+      throw;
+    } catch (const std::exception& e) {
+      sd::write_file_atomically(marker, fmt::format("{}\n", e.what()));
+      throw;
+    }
+  }
+  if (!collect_only) {
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe");
+    if (backend == "slurm") {
+      const auto [array, collect] = sd::submit_slurm(spec, out, exe);
+      fmt::print(
+          "submitted: job array {} (unfinished points), collect job {} after it; results "
+          "in {}/sweep.csv and fits.json\n",
+          array.empty() ? "none" : array, collect, out.string());
+      return 0;
+    }
+    const int failed = sd::run_local(spec, out, jobs > 0 ? jobs : spec.jobs, exe);
+    if (failed > 0)
+      fmt::print(stderr, "sweep: {} point(s) failed; collecting the others\n", failed);
+  }
+  const auto fits = sd::collect_sweep(spec, out);
+  fmt::print("{}: {}/{} points finished; {}/sweep.csv, {}/fits.json\n", out.string(),
+             fits["finished"].get<long>(), fits["points"].get<long>(), out.string(), out.string());
+  for (const auto& g : fits["groups"]) {
+    const auto& f = g["fits"];
+    fmt::print("  {}:", g["axes"].dump());
+    for (const char* k : {"D_vs_J", "dv_vs_J", "psi_vs_J"})
+      if (f[k].contains("b"))
+        fmt::print(" {} = {:.3g} J^{:.3f}+-{:.3f};", k, f[k]["a"].get<double>(),
+                   f[k]["b"].get<double>(), f[k]["b_stderr"].get<double>());
+    if (f["phi_of_J"].contains("phi_c"))
+      fmt::print(" phi = {:.4f} - {:.3g} J^{:.3f}", f["phi_of_J"]["phi_c"].get<double>(),
+                 f["phi_of_J"]["a"].get<double>(), f["phi_of_J"]["b"].get<double>());
+    fmt::print("\n");
+  }
+  return fits["finished"].get<long>() == fits["points"].get<long>() ? 0 : kExitNumerical;
+}
+
+// A summary value, NaN when absent or not a number: summaries of older versions or of runs
+// that ended early lack some keys, and printing must not abort on them.
+double num(const nlohmann::json& js, const char* key) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_number() ? it->get<double>() : NAN;
+}
+double num_at(const nlohmann::json& js, const char* key, std::size_t i) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_array() && i < it->size() && (*it)[i].is_number()
+             ? (*it)[i].get<double>()
+             : NAN;
+}
+void print_warnings(const nlohmann::json& js) {
+  const auto it = js.find("analysis_warnings");
+  if (it == js.end() || !it->is_array()) return;
+  for (const auto& w : *it)
+    if (w.is_string()) fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -57,9 +136,31 @@ int main(int argc, char** argv) {
 
   std::string run_dir;
   auto* analyse = app.add_subcommand(
-      "analyse", "Recompute the diffusion analysis (MSD, D, dv, VACF, Psi) of a finished run "
-                 "from DIR/trajectory.h5 alone; rewrites DIR/analysis.h5 and summary.json");
+      "analyse",
+      "Recompute the diffusion analysis (MSD, D, dv, VACF, Psi) of a finished run "
+      "from DIR/trajectory.h5 alone; rewrites DIR/analysis.h5 and summary.json");
   analyse->add_option("dir", run_dir, "Run directory")->required();
+
+  std::string sweep_file, backend;
+  int jobs = 0;
+  long point = -1;
+  bool collect_only = false;
+  auto* sweep = app.add_subcommand(
+      "sweep",
+      "Run every point of a sweep file (axes over J, ktilde, N, seeds, ...) as its own "
+      "run directory DIR/points/NAME, skipping finished points and resuming "
+      "interrupted ones, then write DIR/sweep.csv and DIR/fits.json (docs/sweeps.md)");
+  sweep->add_option("sweep_file", sweep_file, "Sweep file (TOML)")->required();
+  sweep->add_option("--out", out_dir, "Sweep folder")->required();
+  sweep->add_option("--jobs", jobs, "Worker processes (local backend; default sweep.jobs)")
+      ->check(CLI::Range(1, 256));
+  sweep->add_option("--backend", backend, "local or slurm (default sweep.backend)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  sweep->add_option("--point", point, "Run only point I (what a worker or a Slurm task does)")
+      ->check(CLI::NonNegativeNumber);
+  sweep->add_flag("--collect", collect_only,
+                  "Only collect finished points into sweep.csv and "
+                  "fits.json (what the Slurm collect job does)");
 
   CLI11_PARSE(app, argc, argv);
 
@@ -70,17 +171,19 @@ int main(int argc, char** argv) {
     }
     if (analyse->parsed()) {
       const auto js = sheardiff::reanalyse_run(run_dir);
-      fmt::print("{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
-                 "(log-log slope {:.3f}); dv = {:.4g} gammadot d; Psi = {:.4g} / gammadot; "
-                 "step length {:.4g} d\n",
-                 run_dir, js["D"].get<double>(), js["D_stderr"].get<double>(),
-                 js["msd_window"][0].get<double>(), js["msd_window"][1].get<double>(),
-                 js["msd_window_slope"].is_null() ? NAN : js["msd_window_slope"].get<double>(),
-                 js["dv"].get<double>(), js["psi"].get<double>(), js["step_length"].get<double>());
-      for (const auto& w : js["analysis_warnings"]) fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+      fmt::print(
+          "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
+          "(log-log slope {:.3f}); dv = {:.4g} gammadot d; Psi = {:.4g} / gammadot; "
+          "step length {:.4g} d\n",
+          run_dir, num(js, "D"), num(js, "D_stderr"), num_at(js, "msd_window", 0),
+          num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"), num(js, "psi"),
+          num(js, "step_length"));
+      print_warnings(js);
       return 0;
     }
+    if (sweep->parsed()) return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only);
     const sheardiff::Config cfg = sheardiff::load_config(config_path, overrides);
+    sheardiff::validate_run_inputs(cfg, config_path);
     if (check->parsed()) {
       std::cout << sheardiff::to_toml(cfg);
       return 0;
@@ -88,42 +191,53 @@ int main(int argc, char** argv) {
     const bool resume = !resume_dir.empty();
     if (resume) out_dir = resume_dir;
     const auto summary = sheardiff::run_to_directory(cfg, out_dir, true, resume);
+    const auto flag = [&](const char* key) {
+      const auto it = summary.find(key);
+      return it != summary.end() && it->is_boolean() && it->get<bool>();
+    };
+    const auto count = [&](const char* key) {
+      const auto it = summary.find(key);
+      return it != summary.end() && it->is_number() ? it->get<long>() : 0L;
+    };
     fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
-               out_dir, summary["strain"].get<double>(), summary["steps"].get<long>(),
-               summary["wall_seconds"].get<double>(), summary["ms_per_step"].get<double>(),
-               summary["max_overlap"].get<double>());
+               out_dir, num(summary, "strain"), count("steps"), num(summary, "wall_seconds"),
+               num(summary, "ms_per_step"), num(summary, "max_overlap"));
     if (summary.contains("steady")) {
-      if (!summary["steady"].get<bool>()) {
+      if (!flag("steady")) {
         fmt::print("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
-                   summary["phi"].get<double>());
+                   num(summary, "phi"));
       } else {
-        fmt::print("  steady from strain {:.3g}: phi = {:.4f} +- {:.4f}, mu = {:.4f}, H = {:.3f} d\n",
-                   summary["steady_strain"].get<double>(), summary["phi"].get<double>(),
-                   summary["phi_std"].get<double>(), summary["mu"].get<double>(),
-                   summary["H"].get<double>());
-        fmt::print("  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
-                   "held steps)\n",
-                   summary["pressure_measured"].get<double>(),
-                   summary["pressure_max_relative_error"].get<double>(),
-                   summary["steps"].get<long>() - summary["wall_free_fall_steps"].get<long>());
+        fmt::print(
+            "  steady from strain {:.3g}: phi = {:.4f} +- {:.4f}, mu = {:.4f}, H = {:.3f} d\n",
+            num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_std"),
+            num(summary, "mu"), num(summary, "H"));
+        fmt::print(
+            "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
+            "held steps)\n",
+            num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
+            count("steps") - count("wall_free_fall_steps"));
       }
-    } else if (summary["shear_stress"].is_null()) {
+    } else if (std::isnan(num(summary, "shear_stress"))) {
       fmt::print("  no averages: the run ended before run.transient_strain\n");
     } else {
       fmt::print("  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
-                 summary["shear_stress"].get<double>(), summary["pressure"].get<double>(),
-                 summary["viscosity"].get<double>());
+                 num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
     }
     if (summary.contains("D"))
-      fmt::print("  diffusion: D = {:.4g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
-                 "gammadot d, Psi = {:.4g} / gammadot\n",
-                 summary["D"].get<double>(), summary["msd_window"][0].get<double>(),
-                 summary["msd_window"][1].get<double>(), summary["dv"].get<double>(),
-                 summary["psi"].get<double>());
-    if (summary.contains("analysis_warnings"))
-      for (const auto& w : summary["analysis_warnings"])
-        fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+      fmt::print(
+          "  diffusion: D = {:.4g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
+          "gammadot d, Psi = {:.4g} / gammadot\n",
+          num(summary, "D"), num_at(summary, "msd_window", 0), num_at(summary, "msd_window", 1),
+          num(summary, "dv"), num(summary, "psi"));
+    print_warnings(summary);
     return 0;
+  } catch (const sheardiff::RunUnhealthy& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    fmt::print(stderr, "  diagnostic frame: {}/diagnostic.txt; checkpoint {}\n", out_dir,
+               e.report.state_finite ? "written at this step"
+                                     : "not written (state not finite; "
+                                       "the previous one, if any, kept)");
+    return sheardiff::kExitUnhealthy;
   } catch (const sheardiff::RunInterrupted& e) {
     fmt::print(stderr, "{}\n", e.what());
     return 128 + e.signal;

@@ -51,6 +51,26 @@ bool Dynamics::solve(double dt_implicit, Velocities& v) {
                               wall_drive(), v);
 }
 
+int Dynamics::stick_reversed_sliding(const Velocities& v) {
+  auto& pairs = neighbours_.pairs();
+  const auto& terms = force_balance_.terms();
+  int changed = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    ContactHistory& c = pairs[k].contact;
+    if (!c.active || !c.sliding) continue;
+    const PairTerm& t = terms[k];
+    Vec6 u;
+    u << v.u[pairs[k].i], v.u[pairs[k].j] + t.image_j;
+    // Sliding means slipping in the direction of the stretch (xi grows past the cap); a slip
+    // against it unloads the spring, which then sticks (Coulomb: |f_t| < mu f_n).
+    if (FrictionalContact::slip_rate(t.g, u) * c.xi < 0.0) {
+      c.sliding = false;
+      ++changed;
+    }
+  }
+  return changed;
+}
+
 const char* to_string(StepLimit l) {
   switch (l) {
     case StepLimit::Fixed: return "fixed";
@@ -65,6 +85,11 @@ const char* to_string(StepLimit l) {
   return "?";
 }
 
+double Dynamics::fixed_step() const {
+  const double rest = limits_.end_time - time_;
+  return rest > 0.0 && rest < limits_.fixed_dt ? rest : limits_.fixed_dt;
+}
+
 double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   StepLimit why = StepLimit::Fixed;
   const auto take = [&](double cand, double& dt, StepLimit l) {
@@ -72,7 +97,7 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   };
   if (limits_.fixed_dt > 0.0) {
     if (which) *which = why;
-    return limits_.fixed_dt;
+    return fixed_step();
   }
   constexpr double kBig = std::numeric_limits<double>::infinity();
   double dt = flow_.gammadot > 0.0 ? limits_.max_strain_step / flow_.gammadot : kBig;

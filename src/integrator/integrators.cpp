@@ -4,6 +4,10 @@
 
 namespace sheardiff {
 
+namespace {
+constexpr int kStickPasses = 4;  // re-solves per step for sliding contacts that stick
+}  // namespace
+
 bool ExplicitEuler::step(Dynamics& d) {
   d.begin_step();
   if (!d.solve(0.0, last_)) return false;
@@ -23,10 +27,13 @@ bool Heun::step(Dynamics& d) {
   StepLimit why;
   dt_ = d.dt_limit(predictor_, &why);
   d.count_step_limit(why);
+  predictor_terms_ = d.force_balance().terms();
   const Dynamics::Saved start = d.save();
   d.advance(dt_, predictor_, /*allow_rebuild=*/false);
   const bool ok = d.solve(0.0, last_);
   ++solves_;
+  corrector_ = last_;
+  corrector_terms_ = d.force_balance().terms();
   d.restore(start);
   if (!ok) return false;
   for (std::size_t i = 0; i < last_.u.size(); ++i) last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
@@ -39,7 +46,7 @@ bool Heun::step(Dynamics& d) {
 bool ImplicitSprings::step(Dynamics& d) {
   d.begin_step();
   const bool fixed = d.limits().fixed_dt > 0.0;
-  double dt = fixed ? d.limits().fixed_dt : next_dt_;
+  double dt = fixed ? d.fixed_step() : next_dt_;
   if (dt <= 0.0) {
     // First step: the limits evaluated on the explicit-spring velocities.
     if (!d.solve(0.0, last_)) return false;
@@ -50,6 +57,15 @@ bool ImplicitSprings::step(Dynamics& d) {
   for (int attempt = 0;; ++attempt) {
     if (!d.solve(dt, last_)) return false;
     ++solves_;
+    // Sliding contacts whose explicit Coulomb force reversed their slip stick instead and the
+    // step is solved again with their tangential stiffness (a few passes: contacts only ever
+    // go from sliding to sticking here). Without this, at steps where the cap force reverses
+    // the slip by more than the cap in one step, such contacts chatter between +cap and -cap
+    // (docs/low_j.md).
+    for (int pass = 0; pass < kStickPasses && d.stick_reversed_sliding(last_) > 0; ++pass) {
+      if (!d.solve(dt, last_)) return false;
+      ++solves_;
+    }
     if (fixed) break;
     StepLimit now;
     const double allowed = d.dt_limit(last_, &now);

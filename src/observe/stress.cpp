@@ -5,9 +5,27 @@
 namespace sheardiff {
 
 StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz) {
+  return measure_stress(d, d.force_balance().terms(), v, lz);
+}
+
+StressSample average(const StressSample& a, const StressSample& b) {
+  StressSample m = a;
+  m.sxx = 0.5 * (a.sxx + b.sxx);
+  m.sxy = 0.5 * (a.sxy + b.sxy);
+  m.syy = 0.5 * (a.syy + b.syy);
+  m.max_overlap = std::max(a.max_overlap, b.max_overlap);
+  m.mean_overlap = 0.5 * (a.mean_overlap + b.mean_overlap);
+  m.top_wall_fx = 0.5 * (a.top_wall_fx + b.top_wall_fx);
+  m.top_wall_fy = 0.5 * (a.top_wall_fy + b.top_wall_fy);
+  m.bottom_wall_fx = 0.5 * (a.bottom_wall_fx + b.bottom_wall_fx);
+  m.bottom_wall_fy = 0.5 * (a.bottom_wall_fy + b.bottom_wall_fy);
+  return m;
+}
+
+StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& terms,
+                            const Velocities& v, double lz) {
   StressSample s;
   const auto& pairs = d.neighbours().pairs();
-  const auto& terms = d.force_balance().terms();
   const Particles& p = d.particles();
   double overlap_sum = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {

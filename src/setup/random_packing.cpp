@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace sheardiff {
 
 namespace {
@@ -47,6 +49,39 @@ Vec2 min_image(Vec2 d, double lx, double ly, bool periodic_y) {
   d.x() -= lx * std::round(d.x() / lx);
   if (periodic_y) d.y() -= ly * std::round(d.y() / ly);
   return d;
+}
+
+// Places the discs of pk (radii set) one by one at random in an lx x ly periodic cell, large
+// first; false if one found no free spot.
+bool random_sequential_addition(Packing& pk, double lx, double ly, double size_ratio,
+                                std::uint64_t seed) {
+  const auto n = pk.radius.size();
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> ux(0.0, lx), uy(0.0, ly);
+  const double amax = 0.5 * std::max(1.0, size_ratio);
+  Grid grid(lx, ly, 2.0 * amax);
+  pk.position.assign(n, Vec2::Zero());
+  std::vector<std::size_t> order(n);
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = order.size() - 1 - k;
+  for (std::size_t k : order) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
+      const Vec2 x(ux(rng), uy(rng));
+      bool free = true;
+      grid.neighbours(x, [&](int j) {
+        if (!free) return;
+        const Vec2 d = min_image(pk.position[j] - x, lx, ly, true);
+        if (d.norm() < pk.radius[k] + pk.radius[j]) free = false;
+      });
+      if (free) {
+        pk.position[k] = x;
+        grid.insert(static_cast<int>(k), x);
+        placed = true;
+      }
+    }
+    if (!placed) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -112,35 +147,24 @@ Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double ph
   pk.lx = std::sqrt(area / phi / aspect);
   pk.ly = aspect * pk.lx;
 
-  // Random sequential addition, large discs first, in a cell dilated to phi_rsa.
-  const double phi_rsa = std::min(phi, 0.5);
-  const double scale = std::sqrt(phi / phi_rsa);
-  const double lx = pk.lx * scale, ly = pk.ly * scale;
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> ux(0.0, lx), uy(0.0, ly);
-  const double amax = 0.5 * std::max(1.0, size_ratio);
-  Grid grid(lx, ly, 2.0 * amax);
-  pk.position.assign(static_cast<std::size_t>(n), Vec2::Zero());
-  std::vector<std::size_t> order(static_cast<std::size_t>(n));
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = order.size() - 1 - k;
-  for (std::size_t k : order) {
-    bool placed = false;
-    for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
-      const Vec2 x(ux(rng), uy(rng));
-      bool free = true;
-      grid.neighbours(x, [&](int j) {
-        if (!free) return;
-        const Vec2 d = min_image(pk.position[j] - x, lx, ly, true);
-        if (d.norm() < pk.radius[k] + pk.radius[j]) free = false;
-      });
-      if (free) {
-        pk.position[k] = x;
-        grid.insert(static_cast<int>(k), x);
-        placed = true;
-      }
-    }
-    if (!placed) throw std::runtime_error("random_packing: random sequential addition failed");
+  // Random sequential addition, large discs first, in a cell dilated to phi_rsa. Small or
+  // elongated monodisperse cells can jam below 0.5 (the RSA limit is ~0.55 only for large
+  // square cells): then start sparser, the compression below does the rest.
+  double phi_rsa = 0.0, scale = 1.0, lx = 0.0, ly = 0.0;
+  bool placed_all = false;
+  for (const double start : {0.5, 0.4, 0.3, 0.2}) {
+    if (phi_rsa > 0.0 && start >= phi) continue;  // the same attempt again
+    phi_rsa = std::min(phi, start);
+    scale = std::sqrt(phi / phi_rsa);
+    lx = pk.lx * scale, ly = pk.ly * scale;
+    placed_all = random_sequential_addition(pk, lx, ly, size_ratio, seed);
+    if (placed_all) break;
   }
+  if (!placed_all)
+    throw ConfigError(fmt::format(
+        "particles.phi_init: random placement of {} discs (size_ratio {}, aspect {}) failed even "
+        "at area fraction {}; use an aspect closer to 1, more particles, or particles.init_file",
+        n, size_ratio, aspect, phi_rsa));
   if (scale > 1.0) {
     // Compress towards the target in steps of 0.01 in area fraction, relaxing at each one.
     double cur = phi_rsa;

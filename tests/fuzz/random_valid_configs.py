@@ -6,7 +6,9 @@ integrator and Cholesky, lubrication on/off, frictional or not, J in [1e-5, 1], 
 Each configuration is written to a file and run with `sheardiff run CONFIG --out DIR` under a
 timeout. A run must end in one of two ways:
   ok        exit 0 and a readable DIR/summary.json with a finite strain and steps > 0;
-  detected  exit 3 with an "error: ..." message (a numerical failure the code caught).
+  detected  exit 3 with an "error: ..." message (a numerical failure the code caught), or
+            exit 4 with "error: run health: ..." (a run health check stopped it,
+            docs/stability.md).
 Anything else is a failure: a signal (crash, abort), a hang (timeout), exit 1, or exit 2 (a
 generated configuration was rejected: the generator and the validator disagree). The
 configuration of every failure is printed and, with --keep DIR, saved there.
@@ -198,8 +200,8 @@ def main():
             if rc == 0:
                 problem = summary_ok(out)
                 verdict, what = ("ok", "") if problem is None else ("FAIL", problem)
-            elif rc == 3 and "error:" in err:
-                verdict, what = "detected", err.strip().splitlines()[-1]
+            elif (rc == 3 and "error:" in err) or (rc == 4 and "run health:" in err):
+                verdict, what = "detected", next((l for l in err.splitlines() if l.startswith("error:")), err.strip())
             else:
                 verdict = "FAIL"
                 what = ("hang: no exit within the timeout" if rc is None
@@ -230,7 +232,7 @@ def main():
         print(f"\n--- case {k} ({verdict}): {what}\n{text}")
     total = time.monotonic() - t_start
     print(f"\n{a.count} random valid configs (seed {a.seed}) in {total:.1f} s: "
-          f"{counts['ok']} ok, {counts['detected']} detected numerical failures (exit 3), "
+          f"{counts['ok']} ok, {counts['detected']} detected numerical failures (exit 3 or 4), "
           f"{counts['known']} known bugs, {counts['FAIL']} failures")
     bad = counts["FAIL"] + (counts["known"] if a.strict else 0)
     return 1 if bad else 0

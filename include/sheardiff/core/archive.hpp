@@ -70,6 +70,7 @@ class Archive {
  private:
   Archive(bool loading, std::vector<char> bytes) : loading_(loading), buf_(std::move(bytes)) {}
   void raw(void* p, std::size_t n) {
+    if (n == 0) return;  // an empty vector's data() may be null: memcpy(null, ...) is UB
     if (loading_) {
       if (pos_ + n > buf_.size()) throw std::runtime_error("checkpoint: file is truncated");
       std::memcpy(p, buf_.data() + pos_, n);

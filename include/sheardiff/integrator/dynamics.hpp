@@ -20,6 +20,7 @@ struct StepLimits {
   double max_overlap_change = 1e-3;
   double max_strain_step = 1e-2;
   double explicit_dt = 0.0;        // stability cap of explicit springs (0 = none)
+  double end_time = 0.0;           // a fixed dt is shortened to land on it (0 = none)
 };
 
 // Which limit set a step (reported as fractions of steps in summary.json).
@@ -45,8 +46,15 @@ class Dynamics {
   void begin_step();
   // Velocities at the current configuration; dt_implicit > 0 for implicit springs.
   bool solve(double dt_implicit, Velocities& v);
+  // Implicit springs: a contact that entered the step sliding (its Coulomb force carried
+  // explicitly, no tangential stiffness) but whose solved slip v runs against its spring is not
+  // sliding in this step: it is marked sticking so that a re-solve gives it its tangential
+  // stiffness. Returns how many contacts changed (0: the sliding set is consistent with v).
+  int stick_reversed_sliding(const Velocities& v);
   // Largest step the limits allow for these velocities (fixed_dt if set); *which says which.
   double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
+  // fixed_dt, shortened on the last step so that a run ends exactly at limits().end_time.
+  double fixed_step() const;
   // Integrators report the limit that set each step they take.
   void count_step_limit(StepLimit l) { ++limit_counts_[static_cast<int>(l)]; }
   const std::array<long, static_cast<int>(StepLimit::Count)>& step_limit_counts() const {

@@ -3,6 +3,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/dynamics.hpp"
+#include "sheardiff/observe/stress.hpp"
 
 namespace sheardiff {
 
@@ -16,6 +17,10 @@ class Integrator {
   const Velocities& velocities() const { return last_; }
   double last_dt() const { return dt_; }
   long solves() const { return solves_; }
+  // Stresses and wall forces of the last step, consistent with the velocities it moved with.
+  virtual StressSample sample(const Dynamics& d, double lz) const {
+    return measure_stress(d, last_, lz);
+  }
   // Whether the springs sit inside the matrix (the force balance must keep the full pattern).
   virtual bool implicit_springs() const { return false; }
   // Step-size memory and counters, for checkpoints.
@@ -44,9 +49,17 @@ class ExplicitEuler final : public Integrator {
 class Heun final : public Integrator {
  public:
   bool step(Dynamics& d) override;
+  // The particles moved with the mean of the two stages' velocities, so the stress is the mean
+  // of the two stages' samples, each at its own geometry: the wall then carries exactly P Lx lz
+  // as it does at each stage (one stage's terms with the mean velocities balance nothing).
+  StressSample sample(const Dynamics& d, double lz) const override {
+    return average(measure_stress(d, predictor_terms_, predictor_, lz),
+                   measure_stress(d, corrector_terms_, corrector_, lz));
+  }
 
  private:
-  Velocities predictor_;
+  Velocities predictor_, corrector_;
+  std::vector<PairTerm> predictor_terms_, corrector_terms_;
 };
 
 // Linearly implicit springs: (A + dt K) U = g, stable for any dt; dt chosen by accuracy from

@@ -20,5 +20,10 @@ struct StressSample {
 };
 
 StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz);
+// The same with pair terms other than the last solve's (a stage of a multi-stage integrator).
+StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& terms,
+                            const Velocities& v, double lz);
+// Weighted mean of two samples (stresses, wall forces, overlaps); the contact count of `a`.
+StressSample average(const StressSample& a, const StressSample& b);
 
 }  // namespace sheardiff

@@ -1,0 +1,11 @@
+#pragma once
+#include <filesystem>
+#include <string>
+
+namespace sheardiff {
+
+// Writes to FILE.tmp, flushes it to disk, then renames it over FILE: a reader (or a run killed
+// mid-write) sees the old file or the new one, never a half-written one.
+void write_file_atomically(const std::filesystem::path& file, const std::string& bytes);
+
+}  // namespace sheardiff

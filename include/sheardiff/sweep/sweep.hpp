@@ -1,0 +1,76 @@
+#pragma once
+// A batch of runs over the product of config axes (J, ktilde, N, seed, ...): the sweep file, its
+// points, the local process pool, the Slurm job array, and the collection into sweep.csv and
+// fits.json. Every point is an ordinary run directory DIR/points/<name>/ (docs/sweeps.md).
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sheardiff {
+
+struct SweepSpec {
+  std::filesystem::path file;  // the sweep file itself (absolute)
+  std::filesystem::path base;  // base config (absolute; relative paths resolve from `file`)
+  // Overrides applied to every point, then one value per axis: "section.key" -> values, the
+  // values kept as TOML text so that they reach the config parser exactly as --set would.
+  std::vector<std::pair<std::string, std::string>> set;
+  std::vector<std::pair<std::string, std::vector<std::string>>> axes;
+  int jobs = 2;
+  std::string backend = "local";
+  struct Slurm {
+    int throttle = 0;  // at most this many array tasks at once; 0 = no limit
+    std::string time = "1-00:00:00", partition, job_name = "sheardiff";
+    int cpus_per_task = 1;
+    std::string mem_per_task = "2G";
+    std::vector<std::string> extra;  // further sbatch options, e.g. "--account=foo"
+  } slurm;
+};
+
+struct SweepPoint {
+  long index = 0;
+  std::string name;                    // directory name, e.g. J=0.001_ktilde=10000_N=250_seed=1
+  std::vector<std::string> overrides;  // "key=value", set then axes
+  double cost = 1;                     // relative cost estimate, for scheduling and the ETA
+};
+
+// Reads and checks the sweep file, then builds and validates every point's config before any
+// work starts. Throws ConfigError naming the file and key.
+SweepSpec load_sweep(const std::filesystem::path& file);
+std::vector<SweepPoint> expand_points(const SweepSpec& spec);
+
+std::filesystem::path point_dir(const std::filesystem::path& out_dir, const SweepPoint& p);
+
+enum class PointState { finished, resumable, fresh };
+// finished: summary.json present and config.toml equal to the point's config; a point directory
+// holding another config is an error (never mix). resumable: a checkpoint.bin is there.
+PointState point_state(const SweepSpec& spec, const SweepPoint& p,
+                       const std::filesystem::path& out_dir);
+
+// Runs one point to its end in this process (resuming or starting afresh as its state says).
+// Throws what run_to_directory throws.
+void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
+
+// Local backend: `jobs` worker processes of `exe sweep FILE --out DIR --point I`, a progress
+// line on stderr, SIGINT/SIGTERM forwarded (workers checkpoint). Returns the number of failed
+// points; throws RunInterrupted-like std::runtime_error on a signal.
+int run_local(const SweepSpec& spec, const std::filesystem::path& out_dir, int jobs,
+              const std::filesystem::path& exe);
+
+// Slurm backend: writes DIR/slurm/{array,collect}.sbatch and submits the array (unfinished
+// points only, % throttle) and a collect job depending on it. Returns the two job ids.
+std::pair<std::string, std::string> submit_slurm(const SweepSpec& spec,
+                                                 const std::filesystem::path& out_dir,
+                                                 const std::filesystem::path& exe);
+
+// Reads every point's summary.json and writes DIR/sweep.csv and DIR/fits.json (atomically).
+// Returns fits.json.
+nlohmann::json collect_sweep(const SweepSpec& spec, const std::filesystem::path& out_dir);
+
+// The fits of one group of runs (same ktilde, N, ...): power laws of D, dv, Psi against J and
+// against phi_c - phi, phi(J) = phi_c - a J^b and mu(J) = mu_c + a J^b. rows: one per J, keys
+// J, phi, mu, D, dv, psi (seeds already averaged). Fits that lack points hold {"error": why}.
+nlohmann::json fit_group(const std::vector<nlohmann::json>& rows);
+
+}  // namespace sheardiff

@@ -1,0 +1,273 @@
+// Collecting a sweep: one sweep.csv row per point (all summary.json keys) and fits.json (the
+// seed's power laws per group of points that differ only in J and seed).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "sheardiff/analysis/power_law.hpp"
+#include "sheardiff/config.hpp"
+#include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/sweep/sweep.hpp"
+
+namespace sheardiff {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+bool is_seed_axis(const std::string& key) {
+  return key.ends_with(".seed");
+}
+
+std::string csv_cell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_number_float()) return fmt::format("{}", v.get<double>());
+  if (v.is_number()) return v.dump();
+  if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
+  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// A summary flattened to scalars: arrays become key_0, key_1, ...
+void flatten(const json& summary, std::map<std::string, json>& row) {
+  for (const auto& [k, v] : summary.items()) {
+    if (v.is_array()) {
+      if (v.size() <= 4 &&
+          std::all_of(v.begin(), v.end(), [](const json& e) { return e.is_primitive(); }))
+        for (size_t i = 0; i < v.size(); ++i) row[fmt::format("{}_{}", k, i)] = v[i];
+      else
+        row[k] = v.dump();
+    } else if (v.is_object()) {
+      row[k] = v.dump();
+    } else {
+      row[k] = v;
+    }
+  }
+}
+
+double num(const json& s, const char* key) {
+  if (!s.contains(key) || !s[key].is_number()) return NAN;
+  return s[key].get<double>();
+}
+
+json law_json(const PowerLawFit& f) {
+  return {{"a", f.a},  {"a_stderr", f.a_stderr}, {"b", f.b}, {"b_stderr", f.b_stderr}, {"n", f.n},
+          {"r2", f.r2}};
+}
+
+// Fits y = a x^b over the rows where both are finite and positive; {"error": ...} otherwise.
+json power_fit(const std::vector<double>& x, const std::vector<double>& y) {
+  std::vector<double> xs, ys;
+  for (size_t i = 0; i < x.size(); ++i)
+    if (std::isfinite(x[i]) && std::isfinite(y[i]) && x[i] > 0 && y[i] > 0) {
+      xs.push_back(x[i]);
+      ys.push_back(y[i]);
+    }
+  try {
+    return law_json(fit_power_law(xs, ys));
+  } catch (const std::invalid_argument& e) {
+    return {{"error", e.what()}, {"n", xs.size()}};
+  }
+}
+
+// phi_c - a x^b (sign = +1) or, for mu(J) = mu_c + a x^b, the same fit of -mu (sign = -1).
+json dilatancy_fit(const std::vector<double>& x, const std::vector<double>& y, double sign,
+                   const char* critical) {
+  std::vector<double> xs, ys;
+  for (size_t i = 0; i < x.size(); ++i)
+    if (std::isfinite(x[i]) && std::isfinite(y[i]) && x[i] > 0) {
+      xs.push_back(x[i]);
+      ys.push_back(sign * y[i]);
+    }
+  try {
+    const auto f = fit_dilatancy(xs, ys);
+    return {{critical, sign * f.phi_c},
+            {std::string(critical) + "_stderr", f.phi_c_stderr},
+            {std::string(critical) + "_err_seed", f.phi_c_err},
+            {"a", f.law.a},
+            {"b", f.law.b},
+            {"a_stderr", f.a_stderr_joint},
+            {"b_stderr", f.b_stderr_joint},
+            {"a_stderr_seed", f.law.a_stderr},
+            {"b_stderr_seed", f.law.b_stderr},
+            {"n", f.law.n},
+            {"r2", f.law.r2}};
+  } catch (const std::invalid_argument& e) {
+    return {{"error", e.what()}, {"n", xs.size()}};
+  }
+}
+
+// Seed Table 1 (suspensions) and eq. (3.3)/(3.4), for side-by-side reading.
+json seed_reference() {
+  const auto law = [](double a, double ae, double b, double be) {
+    return json{{"a", a}, {"a_stderr", ae}, {"b", b}, {"b_stderr", be}};
+  };
+  return {{"D_vs_J", law(0.024, 0.002, -0.26, 0.02)},
+          {"dv_vs_J", law(0.258, 0.008, -0.25, 0.04)},
+          {"psi_vs_J", law(0.35, 0.02, 0.24, 0.02)},
+          {"D_vs_phic_minus_phi", law(0.019, 0.006, -0.61, 0.1)},
+          {"dv_vs_phic_minus_phi", law(0.25, 0.01, -0.54, 0.07)},
+          {"psi_vs_phic_minus_phi", law(0.37, 0.06, 0.51, 0.06)},
+          {"phi_of_J", json{{"phi_c", 0.81}, {"a", 0.64}, {"b", 0.5}}}};
+}
+
+}  // namespace
+
+json fit_group(const std::vector<json>& rows) {
+  std::vector<double> J, phi, mu, D, dv, psi;
+  for (const auto& r : rows) {
+    J.push_back(num(r, "J"));
+    phi.push_back(num(r, "phi"));
+    mu.push_back(num(r, "mu"));
+    D.push_back(num(r, "D"));
+    dv.push_back(num(r, "dv"));
+    psi.push_back(num(r, "psi"));
+  }
+  json fits;
+  fits["D_vs_J"] = power_fit(J, D);
+  fits["dv_vs_J"] = power_fit(J, dv);
+  fits["psi_vs_J"] = power_fit(J, psi);
+  fits["phi_of_J"] = dilatancy_fit(J, phi, +1.0, "phi_c");
+  fits["mu_of_J"] = dilatancy_fit(J, mu, -1.0, "mu_c");
+  if (fits["phi_of_J"].contains("phi_c")) {
+    const double phi_c = fits["phi_of_J"]["phi_c"].get<double>();
+    std::vector<double> x;
+    for (double p : phi) x.push_back(phi_c - p);
+    fits["D_vs_phic_minus_phi"] = power_fit(x, D);
+    fits["dv_vs_phic_minus_phi"] = power_fit(x, dv);
+    fits["psi_vs_phic_minus_phi"] = power_fit(x, psi);
+  } else {
+    const json why = {{"error", "no phi_c: the phi(J) fit failed"}};
+    fits["D_vs_phic_minus_phi"] = fits["dv_vs_phic_minus_phi"] = fits["psi_vs_phic_minus_phi"] =
+        why;
+  }
+  return fits;
+}
+
+json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
+  if (!fs::is_directory(out_dir / "points"))
+    throw ConfigError(fmt::format("{}: no sweep there (no points/ folder)", out_dir.string()));
+  const auto points = expand_points(spec);
+  std::vector<std::map<std::string, json>> table;
+  std::set<std::string> summary_keys;
+  // Groups: points equal on every axis but J and the seeds; within a group, rows by J.
+  std::map<std::string, std::map<double, std::vector<json>>> groups;
+  std::map<std::string, json> group_axes;
+  long finished = 0;
+  for (const auto& p : points) {
+    std::map<std::string, json> row;
+    row["point"] = p.name;
+    const auto dir = point_dir(out_dir, p);
+    json summary;
+    std::string status = "missing";
+    if (fs::exists(dir / "summary.json")) {
+      // A finished point whose config differs from the sweep's is an error, not a row.
+      if (point_state(spec, p, out_dir) == PointState::finished) {
+        std::ifstream in(dir / "summary.json");
+        summary = json::parse(in);
+        status = "done";
+        ++finished;
+      }
+    } else if (fs::exists(out_dir / "logs" / (p.name + ".failed"))) {
+      std::ifstream in(out_dir / "logs" / (p.name + ".failed"));
+      std::string why;
+      std::getline(in, why);
+      status = "failed: " + why;
+    } else if (fs::exists(dir / "checkpoint.bin")) {
+      status = "unfinished";
+    }
+    row["status"] = status;
+    std::string group_key;
+    json axes = json::object();
+    for (const auto& o : p.overrides) {
+      const auto eq = o.find('=');
+      const std::string key = o.substr(0, eq);
+      const bool is_axis = std::any_of(spec.axes.begin(), spec.axes.end(),
+                                       [&](const auto& a) { return a.first == key; });
+      if (!is_axis) continue;
+      row["axis." + key] = o.substr(eq + 1);
+      if (key != "flow.J" && !is_seed_axis(key)) {
+        group_key += o + " ";
+        axes[key] = json::parse(o.substr(eq + 1), nullptr, false);
+      }
+    }
+    if (status == "done") {
+      std::map<std::string, json> flat;
+      flatten(summary, flat);
+      for (auto& [k, v] : flat) {
+        summary_keys.insert(k);
+        row[k] = v;
+      }
+      // A pressure-cell run that never reached steady state has no phi(J) or mu(J) to fit.
+      const bool unsteady = summary.contains("steady") && !summary["steady"].get<bool>();
+      if (unsteady) row["status"] = "done, not steady";
+      if (summary.contains("J") && !unsteady)
+        groups[group_key][summary["J"].get<double>()].push_back(summary);
+      group_axes[group_key] = axes;
+    }
+    table.push_back(std::move(row));
+  }
+
+  // sweep.csv: fixed leading columns, then the axes, then every summary key.
+  std::vector<std::string> columns = {"point", "status"};
+  for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
+  columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
+  std::ostringstream csv;
+  csv << fmt::format("{}\n", fmt::join(columns, ","));
+  for (const auto& row : table) {
+    std::vector<std::string> cells;
+    for (const auto& c : columns) {
+      auto it = row.find(c);
+      cells.push_back(it == row.end() ? "" : csv_cell(it->second));
+    }
+    csv << fmt::format("{}\n", fmt::join(cells, ","));
+  }
+  write_file_atomically(out_dir / "sweep.csv", csv.str());
+
+  json fits;
+  fits["sweep"] = spec.file.string();
+  fits["points"] = points.size();
+  fits["finished"] = finished;
+  fits["seed_table1"] = seed_reference();
+  fits["groups"] = json::array();
+  for (const auto& [key, by_j] : groups) {
+    // Seeds averaged at each J (standard error of their mean where there are several).
+    std::vector<json> rows;
+    for (const auto& [j, runs] : by_j) {
+      json r{{"J", j}, {"runs", runs.size()}};
+      for (const char* q : {"phi", "mu", "D", "dv", "psi", "H"}) {
+        double s = 0, s2 = 0;
+        long n = 0;
+        for (const auto& run : runs) {
+          const double v = num(run, q);
+          if (!std::isfinite(v)) continue;
+          s += v;
+          s2 += v * v;
+          ++n;
+        }
+        if (n == 0) {
+          r[q] = nullptr;
+          continue;
+        }
+        const double mean = s / n;
+        r[q] = mean;
+        r[std::string(q) + "_sem"] =
+            n > 1 ? std::sqrt(std::max(0.0, (s2 - n * mean * mean) / (n - 1)) / n) : 0.0;
+      }
+      rows.push_back(r);
+    }
+    fits["groups"].push_back(
+        {{"axes", group_axes[key]}, {"rows", rows}, {"fits", fit_group(rows)}});
+  }
+  write_file_atomically(out_dir / "fits.json", fits.dump(2) + "\n");
+  return fits;
+}
+
+}  // namespace sheardiff

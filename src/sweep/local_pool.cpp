@@ -1,0 +1,223 @@
+// Running sweep points: one point in this process, or a pool of worker processes.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <map>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/simulation.hpp"
+#include "sheardiff/sweep/sweep.hpp"
+
+extern char** environ;
+
+namespace sheardiff {
+namespace fs = std::filesystem;
+
+namespace {
+
+// An exclusive lock on FILE held for the lifetime of this object (released by the kernel if the
+// process dies): two processes must never run the same point or pool the same sweep folder.
+class FileLock {
+ public:
+  FileLock(const fs::path& file, const std::string& what) {
+    fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error(fmt::format("cannot open {}", file.string()));
+    if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw ConfigError(
+          fmt::format("{} is already being run by another process (lock {})", what, file.string()));
+    }
+  }
+  ~FileLock() { ::close(fd_); }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
+void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
+  fs::create_directories(out_dir / "logs");
+  const FileLock lock(out_dir / "logs" / (p.name + ".lock"), "sweep point " + p.name);
+  const auto state = point_state(spec, p, out_dir);
+  if (state == PointState::finished) return;
+  const Config cfg = load_config(spec.base, p.overrides);
+  const auto dir = point_dir(out_dir, p);
+  // A fresh point may hold the remains of a start killed before its first checkpoint: nothing
+  // in it can be continued, and a stale trajectory must not survive into the new run.
+  if (state == PointState::fresh) fs::remove_all(dir);
+  run_to_directory(cfg, dir, true, state == PointState::resumable);
+}
+
+namespace {
+
+std::string duration_text(double s) {
+  if (!(s >= 0) || s > 1e8) return "?";
+  const long t = std::lround(s);
+  if (t >= 3600) return fmt::format("{}h{:02d}m", t / 3600, (t % 3600) / 60);
+  if (t >= 60) return fmt::format("{}m{:02d}s", t / 60, t % 60);
+  return fmt::format("{}s", t);
+}
+
+struct Worker {
+  const SweepPoint* point;
+  std::chrono::steady_clock::time_point started;
+};
+
+}  // namespace
+
+int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe) {
+  const auto points = expand_points(spec);
+  fs::create_directories(out_dir / "points");
+  fs::create_directories(out_dir / "logs");
+  const FileLock lock(out_dir / "sweep.lock", "the sweep in " + out_dir.string());
+
+  // States first (a foreign directory stops the sweep before anything starts), longest first.
+  std::vector<const SweepPoint*> todo;
+  long finished_before = 0;
+  for (const auto& p : points) {
+    if (point_state(spec, p, out_dir) == PointState::finished)
+      ++finished_before;
+    else
+      todo.push_back(&p);
+  }
+  std::stable_sort(todo.begin(), todo.end(),
+                   [](const SweepPoint* a, const SweepPoint* b) { return a->cost > b->cost; });
+  std::reverse(todo.begin(), todo.end());  // taken from the back
+
+  // Signals are taken synchronously (sigtimedwait), so no handler and no global flag: SIGCHLD
+  // says a worker ended, SIGINT/SIGTERM are forwarded to the workers, which checkpoint.
+  sigset_t mask, old_mask;
+  sigemptyset(&mask);
+  sigaddset(&mask, SIGCHLD);
+  sigaddset(&mask, SIGINT);
+  sigaddset(&mask, SIGTERM);
+  sigprocmask(SIG_BLOCK, &mask, &old_mask);
+  sigset_t child_mask;
+  sigemptyset(&child_mask);
+
+  std::map<pid_t, Worker> running;
+  long done = 0, failed = 0;
+  double done_cost = 0, done_seconds = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last_print = t0 - std::chrono::hours(1);
+  bool changed = true;
+  int stop_signal = 0;
+
+  const auto spawn = [&](const SweepPoint* p) {
+    const std::string log = (out_dir / "logs" / (p->name + ".log")).string();
+    const std::string index = std::to_string(p->index);
+    const std::string file = spec.file.string(), out = out_dir.string(), self = exe.string();
+    std::vector<char*> argv = {const_cast<char*>(self.c_str()),  const_cast<char*>("sweep"),
+                               const_cast<char*>(file.c_str()),  const_cast<char*>("--out"),
+                               const_cast<char*>(out.c_str()),   const_cast<char*>("--point"),
+                               const_cast<char*>(index.c_str()), nullptr};
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setsigmask(&attr, &child_mask);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    posix_spawnattr_destroy(&attr);
+    if (rc != 0)
+      throw std::runtime_error(fmt::format("sweep: cannot start {}: {}", self, std::strerror(rc)));
+    running[pid] = {p, std::chrono::steady_clock::now()};
+  };
+
+  const auto reap = [&] {
+    int status = 0;
+    pid_t pid;
+    while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+      auto it = running.find(pid);
+      if (it == running.end()) continue;
+      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      const double secs =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.started)
+              .count();
+      const auto& p = *it->second.point;
+      if (code == 0) {
+        ++done;
+        done_cost += p.cost;
+        done_seconds += secs;
+      } else if (!stop_signal) {
+        ++failed;
+        fmt::print(stderr, "sweep: point {} failed (exit {}) after {}; see {}\n", p.name, code,
+                   duration_text(secs), (out_dir / "logs" / (p.name + ".log")).string());
+      }
+      running.erase(it);
+      changed = true;
+    }
+  };
+
+  const auto progress = [&] {
+    const auto now = std::chrono::steady_clock::now();
+    if (!changed && now - last_print < std::chrono::seconds(30)) return;
+    const double elapsed = std::chrono::duration<double>(now - t0).count();
+    // Seconds per unit of cost from the points finished so far; a running point is charged
+    // what its estimate has left (at least a tenth of it: estimates are rough).
+    std::string eta = "?";
+    if (done > 0) {
+      const double rate = done_seconds / done_cost;
+      double left = 0;
+      for (const auto* p : todo) left += p->cost * rate;
+      for (const auto& [pid, w] : running) {
+        const double est = w.point->cost * rate;
+        left += std::max(est - std::chrono::duration<double>(now - w.started).count(), 0.1 * est);
+      }
+      eta = duration_text(left / jobs);
+    }
+    fmt::print(stderr,
+               "sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
+               "{} elapsed, ETA {}\n",
+               finished_before + done, points.size(), finished_before, failed, running.size(),
+               todo.size(), duration_text(elapsed), eta);
+    last_print = now;
+    changed = false;
+  };
+
+  while (!todo.empty() || !running.empty()) {
+    while (!stop_signal && static_cast<int>(running.size()) < jobs && !todo.empty()) {
+      spawn(todo.back());
+      todo.pop_back();
+      changed = true;
+    }
+    progress();
+    if (stop_signal && running.empty()) break;
+    const timespec wait{2, 0};
+    const int sig = sigtimedwait(&mask, nullptr, &wait);
+    if ((sig == SIGINT || sig == SIGTERM) && !stop_signal) {
+      stop_signal = sig;
+      fmt::print(stderr, "sweep: signal {}: stopping {} running point(s) at their checkpoint\n",
+                 sig, running.size());
+      for (const auto& [pid, w] : running) kill(pid, SIGTERM);
+    }
+    reap();
+    if (stop_signal && running.empty()) break;
+  }
+  sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+  if (stop_signal)
+    throw RunInterrupted(stop_signal,
+                         fmt::format("sweep stopped by signal {}: run the same command again to "
+                                     "continue (finished points are kept, the others resume)",
+                                     stop_signal));
+  return static_cast<int>(failed);
+}
+
+}  // namespace sheardiff

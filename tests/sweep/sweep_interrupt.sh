@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# A sweep killed mid-run (SIGKILL to its whole process group, as a cluster's job killer or a
+# closed terminal does) and run again must finish without redoing finished points, keep their
+# files and sweep.csv rows unchanged, and never report a half-finished point as done.
+# Usage: sweep_interrupt.sh SHEARDIFF_BIN REPO_DIR WORK_DIR
+set -euo pipefail
+bin=$(realpath "$1"); repo=$(realpath "$2"); work=$3
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+cat > tiny.toml <<TOML
+[sweep]
+base = "$repo/configs/quick.toml"
+jobs = 2
+[sweep.set]
+"particles.N" = 60
+"run.strain" = 3.0
+"steady.window" = 0.5
+"steady.measure_strain" = 1.0
+"output.checkpoint_strain" = 0.2
+[sweep.axes]
+"flow.J" = [0.1, 0.05, 0.02, 0.01]
+TOML
+
+setsid "$bin" sweep tiny.toml --out out > first.log 2>&1 &
+pgid=$!
+for _ in $(seq 600); do  # up to 120 s for the first point to finish
+  compgen -G "out/points/*/summary.json" > /dev/null && break
+  sleep 0.2
+done
+compgen -G "out/points/*/summary.json" > /dev/null || { echo "no point finished"; cat first.log; exit 1; }
+# A second sweep on the same folder while the first runs is refused (exit 2), touching nothing.
+rc=0; "$bin" sweep tiny.toml --out out > concurrent.log 2>&1 || rc=$?
+[ "$rc" = 2 ] && grep -q "already being run by another process" concurrent.log ||
+  { echo "concurrent sweep: exit $rc"; cat concurrent.log; exit 1; }
+kill -KILL -- -"$pgid"
+wait "$pgid" 2>/dev/null || true
+
+# What the killed sweep had finished, and its rows.
+finished=$(cd out/points && ls -d */summary.json | xargs -n1 dirname)
+rc=0; "$bin" sweep tiny.toml --out out --collect > collect.log 2>&1 || rc=$?
+[ "$rc" = 3 ] || { echo "collect of an unfinished sweep: exit $rc, expected 3"; exit 1; }
+grep -q ',done,\|,done$' out/sweep.csv
+for p in $finished; do
+  sha256sum "out/points/$p/summary.json" "out/points/$p/trajectory.h5" >> before.sha
+  grep "^$p," out/sweep.csv >> before.rows
+  wc -c < "out/logs/$p.log" >> before.logsize
+done
+# No unfinished point is reported as done.
+n_done=$(grep -c '^[^,]*,done,' out/sweep.csv || true)
+[ "$n_done" = "$(echo "$finished" | wc -w)" ] || { echo "done rows $n_done != finished points"; exit 1; }
+
+"$bin" sweep tiny.toml --out out > second.log 2>&1
+sha256sum -c --quiet before.sha                       # finished points untouched
+for p in $finished; do grep "^$p," out/sweep.csv; done | diff before.rows -   # same rows
+for p in $finished; do wc -c < "out/logs/$p.log"; done | diff before.logsize - # not rerun
+[ "$(grep -c '^[^,]*,done,' out/sweep.csv)" = 4 ] || { echo "not all points done"; cat second.log; exit 1; }
+grep -q "before this start" second.log
+echo "sweep_interrupt: killed after $(echo "$finished" | wc -w) finished point(s); resumed to 4/4 with them untouched"

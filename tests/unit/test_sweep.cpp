@@ -1,0 +1,155 @@
+// Sweep files, points and fits (the processes and Slurm are tested by tests/sweep/*.sh).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/sweep/sweep.hpp"
+
+namespace fs = std::filesystem;
+using namespace sheardiff;
+
+namespace {
+
+fs::path write_files(const std::string& name, const std::string& sweep) {
+  const auto dir = fs::temp_directory_path() / ("sheardiff_sweep_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "base.toml") << "[scene]\ntype = \"pressure_shear\"\n[particles]\nN = 40\n";
+  std::ofstream(dir / "sweep.toml") << sweep;
+  return dir / "sweep.toml";
+}
+
+std::string error_of(const fs::path& file) {
+  try {
+    load_sweep(file);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Sweep, PointsAreTheProductLastAxisFastest) {
+  const auto file = write_files("product", R"(
+[sweep]
+base = "base.toml"
+[sweep.set]
+"run.strain" = 2.0
+[sweep.axes]
+"flow.J" = [0.1, 1e-3]
+"contact.ktilde" = [1000, 1e4]
+"run.seed" = [1, 2, 3]
+)");
+  const auto spec = load_sweep(file);
+  const auto points = expand_points(spec);
+  ASSERT_EQ(points.size(), 12u);
+  EXPECT_EQ(points[0].name, "J=0.1_ktilde=1000_seed=1");
+  EXPECT_EQ(points[1].name, "J=0.1_ktilde=1000_seed=2");
+  EXPECT_EQ(points[3].name, "J=0.1_ktilde=10000_seed=1");
+  EXPECT_EQ(points[11].name, "J=0.001_ktilde=10000_seed=3");
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_EQ(points[i].index, static_cast<long>(i));
+  // The fixed overrides come first, then one per axis, as --set would take them.
+  EXPECT_EQ(points[11].overrides, (std::vector<std::string>{"run.strain=2", "flow.J=0.001",
+                                                            "contact.ktilde=10000", "run.seed=3"}));
+  // Each point's config is the base plus its overrides.
+  const Config cfg = load_config(spec.base, points[11].overrides);
+  EXPECT_DOUBLE_EQ(cfg.flow.j, 1e-3);
+  EXPECT_DOUBLE_EQ(cfg.contact.ktilde, 1e4);
+  EXPECT_EQ(cfg.particles.n, 40);
+  // Low J costs more steps per strain: it is started first.
+  EXPECT_GT(points[11].cost, points[0].cost);
+}
+
+TEST(Sweep, BadSweepFilesNameTheKey) {
+  EXPECT_NE(error_of(write_files("unknown",
+                                 "[sweep]\nbase = \"base.toml\"\nbsae = 1\n"
+                                 "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
+                .find("unknown key 'bsae'"),
+            std::string::npos);
+  EXPECT_NE(error_of(write_files("nobase",
+                                 "[sweep]\nbase = \"nothere.toml\"\n"
+                                 "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
+                .find("sweep.base = \"nothere.toml\": no such file"),
+            std::string::npos);
+  EXPECT_NE(error_of(write_files("noaxes", "[sweep]\nbase = \"base.toml\"\n")).find("sweep.axes"),
+            std::string::npos);
+  EXPECT_NE(error_of(write_files("emptyaxis",
+                                 "[sweep]\nbase = \"base.toml\"\n"
+                                 "[sweep.axes]\n\"flow.J\" = []\n"))
+                .find("non-empty list"),
+            std::string::npos);
+  EXPECT_NE(error_of(write_files("jobs",
+                                 "[sweep]\nbase = \"base.toml\"\njobs = 0\n"
+                                 "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
+                .find("sweep.jobs = 0: must be in [1, 256]"),
+            std::string::npos);
+  // An axis value the config rejects is found before anything runs, with the point's name.
+  const auto e = error_of(write_files("badpoint",
+                                      "[sweep]\nbase = \"base.toml\"\n"
+                                      "[sweep.axes]\n\"flow.J\" = [0.1, -1.0]\n"));
+  EXPECT_NE(e.find("point J=-1"), std::string::npos) << e;
+  EXPECT_NE(e.find("flow.J"), std::string::npos) << e;
+  EXPECT_NE(error_of(write_files("slurm",
+                                 "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n"
+                                 "\"flow.J\" = [0.1]\n[slurm]\nthrotle = 2\n"))
+                .find("unknown key 'throtle'"),
+            std::string::npos);
+}
+
+TEST(Sweep, FreshAndForeignPointDirectories) {
+  const auto file = write_files("state",
+                                "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n"
+                                "\"flow.J\" = [0.1, 0.01]\n");
+  const auto spec = load_sweep(file);
+  const auto points = expand_points(spec);
+  const auto out = file.parent_path() / "out";
+  EXPECT_EQ(point_state(spec, points[0], out), PointState::fresh);
+  // A finished run of the same config is skipped...
+  const auto dir = point_dir(out, points[0]);
+  fs::create_directories(dir);
+  std::ofstream(dir / "config.toml") << to_toml(load_config(spec.base, points[0].overrides));
+  EXPECT_EQ(point_state(spec, points[0], out), PointState::fresh);  // started, nothing to keep
+  std::ofstream(dir / "checkpoint.bin") << "x";
+  EXPECT_EQ(point_state(spec, points[0], out), PointState::resumable);
+  std::ofstream(dir / "summary.json") << "{}";
+  EXPECT_EQ(point_state(spec, points[0], out), PointState::finished);
+  // ...but a finished run of another config in its place is never mixed in.
+  std::ofstream(dir / "config.toml") << to_toml(load_config(spec.base, points[1].overrides));
+  EXPECT_THROW(point_state(spec, points[0], out), ConfigError);
+}
+
+TEST(Sweep, FitsRecoverSyntheticPowerLaws) {
+  // Exact laws with the seed's values: every fit must give them back.
+  std::vector<nlohmann::json> rows;
+  for (double J : {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 1e-1}) {
+    const double phi = 0.81 - 0.64 * std::sqrt(J);
+    rows.push_back({{"J", J},
+                    {"phi", phi},
+                    {"mu", 0.3 + 0.9 * std::pow(J, 0.4)},
+                    {"D", 0.024 * std::pow(J, -0.25)},
+                    {"dv", 0.26 * std::pow(J, -0.25)},
+                    {"psi", 0.35 * std::pow(J, 0.25)}});
+  }
+  const auto f = fit_group(rows);
+  EXPECT_NEAR(f["D_vs_J"]["a"].get<double>(), 0.024, 1e-9);
+  EXPECT_NEAR(f["D_vs_J"]["b"].get<double>(), -0.25, 1e-9);
+  EXPECT_NEAR(f["dv_vs_J"]["b"].get<double>(), -0.25, 1e-9);
+  EXPECT_NEAR(f["psi_vs_J"]["a"].get<double>(), 0.35, 1e-9);
+  EXPECT_NEAR(f["phi_of_J"]["phi_c"].get<double>(), 0.81, 1e-4);
+  EXPECT_NEAR(f["phi_of_J"]["b"].get<double>(), 0.5, 1e-2);
+  EXPECT_NEAR(f["mu_of_J"]["mu_c"].get<double>(), 0.3, 1e-3);
+  EXPECT_NEAR(f["mu_of_J"]["b"].get<double>(), 0.4, 1e-2);
+  // D ~ J^-1/4 and phi_c - phi ~ J^1/2 give D ~ (phi_c - phi)^-1/2.
+  EXPECT_NEAR(f["D_vs_phic_minus_phi"]["b"].get<double>(), -0.5, 2e-2);
+  EXPECT_NEAR(f["psi_vs_phic_minus_phi"]["b"].get<double>(), 0.5, 2e-2);
+
+  // Too few points: the fit says why instead of inventing numbers.
+  rows.resize(2);
+  const auto g = fit_group(rows);
+  EXPECT_TRUE(g["D_vs_J"].contains("error"));
+  EXPECT_TRUE(g["phi_of_J"].contains("error"));
+  EXPECT_TRUE(g["D_vs_phic_minus_phi"].contains("error"));
+}
