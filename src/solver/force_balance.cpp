@@ -77,6 +77,43 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   return solve_assembled(p, flow, wall, out);
 }
 
+bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
+                                         const ShearFlow& flow, const std::vector<Pair>& pairs,
+                                         const std::vector<std::size_t>& switched,
+                                         double dt_implicit, const WallDrive* wall,
+                                         Velocities& out) {
+  for (std::size_t k : switched)
+    if (p.motion[pairs[k].j] == Motion::FloatingWall)
+      return solve(p, box, flow, pairs, dt_implicit, wall, out);
+  const int d = system_.dof();
+  const double kt = dt_implicit * contact_.kt;
+  VecX w, dg;
+  for (std::size_t k : switched) {
+    const Pair& pr = pairs[k];
+    PairTerm& term = terms_[k];
+    const Vec6 w6 = FrictionalContact::slip_mode(term.g);
+    // The pair term as a new assembly would make it (stresses read it after the step).
+    term.m += kt * w6 * w6.transpose();
+    term.sliding = false;
+    const bool j_mobile = p.motion[pr.j] == Motion::Mobile;
+    // Known velocity of j's side: the Lees-Edwards image's, or zero for a fixed wall.
+    const double known_x = j_mobile ? term.image_j.x() : 0.0;
+    w.setZero(static_cast<Eigen::Index>(system_.unknowns()));
+    dg.setZero(w.size());
+    const double wj_known = w6[3] * known_x;
+    for (int r = 0; r < d; ++r) {
+      w[d * pr.i + r] = w6[r];
+      dg[d * pr.i + r] = -kt * w6[r] * wj_known;
+      if (j_mobile) {
+        w[d * pr.j + r] = w6[3 + r];
+        dg[d * pr.j + r] = -kt * w6[3 + r] * wj_known;
+      }
+    }
+    system_.add_low_rank(w, kt, dg);
+  }
+  return solve_assembled(p, flow, wall, out);
+}
+
 void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow& flow,
                             const std::vector<Pair>& pairs, double dt_implicit,
                             const WallDrive* wall) {
