@@ -141,6 +141,9 @@ const std::vector<KeySpec>& schema() {
                      "1 (reduced gap)",
                      "Lubrication cut-off: active for 0 < h < h_max (must be < 1).",
                      /*hi_open=*/true));
+    s.push_back(boolean("lubrication.tangential", &C::lubrication, &C::Lubrication::tangential,
+                        "Tangential lubrication modes (shear, shear-rotation, pump); off = squeeze "
+                        "only. Off with mu = 0: no rotational unknowns (2 per particle)."));
     s.push_back(real("contact.ktilde", &C::contact, &C::Contact::ktilde, 1.0, 1e9, false,
                      "P d (so kn = ktilde)", "Normal contact stiffness kn / (P d)."));
     s.push_back(real("contact.kt_ratio", &C::contact, &C::Contact::kt_ratio, 0.0, 1.0, false, "",
@@ -183,6 +186,12 @@ const std::vector<KeySpec>& schema() {
         "2.3x faster at N = 1000, docs/performance.md) or `eigen` (Eigen SimplicialLLT).",
         [](const C& c) { return Value{c.solver.cholesky}; },
         [](C& c, const Value& v) { c.solver.cholesky = std::get<std::string>(v); }));
+    s.push_back(choice(
+        "solver.rotations", {"auto", "always"},
+        "Rotational unknowns: `auto` drops omega (2 unknowns per particle) when nothing couples "
+        "rotation to translation (no friction and no tangential lubrication), `always` keeps 3.",
+        [](const C& c) { return Value{c.solver.rotations}; },
+        [](C& c, const Value& v) { c.solver.rotations = std::get<std::string>(v); }));
     s.push_back(real("neighbour.skin", &C::neighbour, &C::Neighbour::skin, 0.0, 5.0, true, "d",
                      "Verlet skin; the list is rebuilt when a particle has moved skin/2."));
     s.push_back(real("run.strain", &C::run, &C::Run::strain, 0.0, 1e5, true, "1",

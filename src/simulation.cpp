@@ -26,7 +26,7 @@ namespace {
 
 std::optional<Lubrication> lubrication_of(const Config& cfg) {
   if (!cfg.lubrication.enabled) return std::nullopt;
-  return Lubrication{cfg.lubrication.delta, cfg.lubrication.h_max};
+  return Lubrication{cfg.lubrication.delta, cfg.lubrication.h_max, cfg.lubrication.tangential};
 }
 
 FrictionalContact contact_of(const Config& cfg) {
@@ -51,6 +51,14 @@ double explicit_stability_dt(const Config& cfg) {
   double dt = 2.0 * rn / c.kn;
   if (c.has_friction()) dt = std::min(dt, 2.0 * rt / c.kt);
   return dt;
+}
+
+bool rotational_unknowns(const Config& cfg) {
+  if (cfg.solver.rotations == "always") return true;
+  // Rotation couples to translation only through friction and the tangential lubrication modes
+  // (which include the contact dashpots); without both, omega = omega_inf + T_ext / drag.
+  const bool tangential_lubrication = cfg.lubrication.enabled && cfg.lubrication.tangential;
+  return contact_of(cfg).has_friction() || tangential_lubrication;
 }
 
 void validate_run_inputs(const Config& cfg, const std::string& origin) {
@@ -90,8 +98,8 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
-  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), 3, integrator_->implicit_springs(),
-                  cfg.solver.cholesky);
+  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), rotational_unknowns(cfg) ? 3 : 2,
+                  integrator_->implicit_springs(), cfg.solver.cholesky);
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
                                          lim, std::move(scene.walls));

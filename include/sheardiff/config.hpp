@@ -34,6 +34,7 @@ struct Config {
     bool enabled = true;
     double delta = 0.01;
     double h_max = 0.5;
+    bool tangential = true;  // shear, shear-rotation and pump modes (off: squeeze only)
   } lubrication;
   struct Contact {
     double ktilde = 1e4;
@@ -51,6 +52,7 @@ struct Config {
   } integrator;
   struct Solver {
     std::string cholesky = "cholmod";
+    std::string rotations = "auto";  // "auto": no omega unknowns when nothing couples them
   } solver;
   struct Neighbour {
     double skin = 0.3;

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/integrators.hpp"
@@ -39,6 +40,14 @@ class Simulation {
 
 // Contact stability limit of explicit springs for these parameters (model.md section 7).
 double explicit_stability_dt(const Config& cfg);
+
+class Observer;
+// The observers the scene and the config ask for (and only those), in their update order.
+std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
+                                                      const std::filesystem::path& out_dir);
+
+// Whether the run needs the rotational unknowns (3 per particle) or only translation (2).
+bool rotational_unknowns(const Config& cfg);
 
 // The checks of a configuration that need the physics or input files (parse_config does the
 // rest): a fixed dt of explicit springs below their stability limit, and particles.init_file

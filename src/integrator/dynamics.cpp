@@ -51,7 +51,14 @@ bool Dynamics::solve(double dt_implicit, Velocities& v) {
                               wall_drive(), v);
 }
 
-int Dynamics::stick_reversed_sliding(const Velocities& v) {
+bool Dynamics::resolve_with_sticking(double dt_implicit, const std::vector<std::size_t>& switched,
+                                     Velocities& v) {
+  return force_balance_.resolve_with_sticking(particles_, box_, flow_, neighbours_.pairs(),
+                                              switched, dt_implicit, wall_drive(), v);
+}
+
+int Dynamics::stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched) {
+  if (switched) switched->clear();
   auto& pairs = neighbours_.pairs();
   const auto& terms = force_balance_.terms();
   int changed = 0;
@@ -66,6 +73,7 @@ int Dynamics::stick_reversed_sliding(const Velocities& v) {
     if (FrictionalContact::slip_rate(t.g, u) * c.xi < 0.0) {
       c.sliding = false;
       ++changed;
+      if (switched) switched->push_back(k);
     }
   }
   return changed;

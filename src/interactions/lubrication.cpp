@@ -9,7 +9,7 @@ PairResistance Lubrication::coefficients(double ai, double aj, double h) const {
   const double he = std::max(h, 0.0) + delta;
   const double ln = 1.0 / he;
   // The log modes are cut where ln(1/(h+delta)) would turn negative.
-  const double lt = ln > 1.0 ? std::log(ln) : 0.0;
+  const double lt = tangential && ln > 1.0 ? std::log(ln) : 0.0;
   const double s = ai + aj;
   const double s2 = s * s, s3 = s2 * s;
   const double c = 6.0 * kPi;

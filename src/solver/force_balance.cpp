@@ -73,6 +73,50 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
 bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
                          const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
                          Velocities& out) {
+  assemble(p, box, flow, pairs, dt_implicit, wall);
+  return solve_assembled(p, flow, wall, out);
+}
+
+bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
+                                         const ShearFlow& flow, const std::vector<Pair>& pairs,
+                                         const std::vector<std::size_t>& switched,
+                                         double dt_implicit, const WallDrive* wall,
+                                         Velocities& out) {
+  for (std::size_t k : switched)
+    if (p.motion[pairs[k].j] == Motion::FloatingWall)
+      return solve(p, box, flow, pairs, dt_implicit, wall, out);
+  const int d = system_.dof();
+  const double kt = dt_implicit * contact_.kt;
+  VecX w, dg;
+  for (std::size_t k : switched) {
+    const Pair& pr = pairs[k];
+    PairTerm& term = terms_[k];
+    const Vec6 w6 = FrictionalContact::slip_mode(term.g);
+    // The pair term as a new assembly would make it (stresses read it after the step).
+    term.m += kt * w6 * w6.transpose();
+    term.sliding = false;
+    const bool j_mobile = p.motion[pr.j] == Motion::Mobile;
+    // Known velocity of j's side: the Lees-Edwards image's, or zero for a fixed wall.
+    const double known_x = j_mobile ? term.image_j.x() : 0.0;
+    w.setZero(static_cast<Eigen::Index>(system_.unknowns()));
+    dg.setZero(w.size());
+    const double wj_known = w6[3] * known_x;
+    for (int r = 0; r < d; ++r) {
+      w[d * pr.i + r] = w6[r];
+      dg[d * pr.i + r] = -kt * w6[r] * wj_known;
+      if (j_mobile) {
+        w[d * pr.j + r] = w6[3 + r];
+        dg[d * pr.j + r] = -kt * w6[3 + r] * wj_known;
+      }
+    }
+    system_.add_low_rank(w, kt, dg);
+  }
+  return solve_assembled(p, flow, wall, out);
+}
+
+void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow& flow,
+                            const std::vector<Pair>& pairs, double dt_implicit,
+                            const WallDrive* wall) {
   if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
   if (dt_implicit > 0.0 && diagonal_only_)
     throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
@@ -86,7 +130,10 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   // Scenes without walls get a loop with no wall branch at all.
   if (wall) assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
   else assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
+}
 
+bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
+                                   Velocities& out) {
   double v = 0.0;
   bool capped = false;
   const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v,
@@ -102,7 +149,14 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   for (std::size_t i = 0; i < p.size(); ++i) {
     switch (p.motion[i]) {
       case Motion::Mobile:
-        out.u[i] = Vec3(u_[d * i], u_[d * i + 1], d == 3 ? u_[d * i + 2] : 0.0);
+        if (d == 3) {
+          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], u_[d * i + 2]);
+        } else {
+          // Without rotational unknowns only drag (and an external torque) acts on omega.
+          double w = flow.velocity(p.position[i]).z();
+          if (!p.external.empty()) w += p.external[i].z() / StokesDrag::resistance(p.radius[i]).z();
+          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], w);
+        }
         break;
       case Motion::FixedWall: out.u[i].setZero(); break;
       case Motion::FloatingWall: out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero(); break;

@@ -19,6 +19,10 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
                                    const Particles& p, bool diagonal_only) {
   n_ = n_mobile;
   diagonal_only_ = diagonal_only;
+  factor_of_a_ = false;
+  lr_w_.clear();
+  lr_k_.clear();
+  lr_ready_ = false;
   const int d = dof_;
   const auto nu = static_cast<Eigen::Index>(unknowns());
   g_.setZero(nu);
@@ -61,7 +65,48 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
   ++analyses_;
 }
 
+void ResistanceSystem::add_low_rank(const VecX& w, double k, const VecX& dg) {
+  if (!factor_of_a_ || diagonal_only_)
+    throw std::logic_error("ResistanceSystem: low-rank terms need the factor of A");
+  lr_w_.push_back(w);
+  lr_k_.push_back(k);
+  g_ += dg;
+  lr_ready_ = false;
+}
+
+bool ResistanceSystem::prepare() {
+  if (factor_of_a_) return true;
+  ++factorisations_;
+  factor_of_a_ = llt_->factorize(a_);
+  return factor_of_a_;
+}
+
+VecX ResistanceSystem::apply_inverse(const VecX& x) {
+  VecX y = llt_->solve(x);
+  if (lr_w_.empty()) return y;
+  // Woodbury: (A + W K W^T)^-1 = A^-1 - Z (K^-1 + W^T Z)^-1 Z^T, Z = A^-1 W.
+  const auto r = static_cast<Eigen::Index>(lr_w_.size());
+  if (!lr_ready_) {
+    lr_z_.resize(x.size(), r);
+    for (Eigen::Index c = 0; c < r; ++c) lr_z_.col(c) = llt_->solve(lr_w_[c]);
+    Eigen::MatrixXd s(r, r);
+    for (Eigen::Index a = 0; a < r; ++a)
+      for (Eigen::Index b = 0; b < r; ++b) s(a, b) = lr_w_[a].dot(lr_z_.col(b));
+    for (Eigen::Index a = 0; a < r; ++a) s(a, a) += 1.0 / lr_k_[a];
+    lr_s_.compute(s);
+    lr_ready_ = true;
+  }
+  VecX wy(r);
+  for (Eigen::Index a = 0; a < r; ++a) wy[a] = lr_w_[a].dot(y);
+  ++low_rank_solves_;
+  return y - lr_z_ * lr_s_.solve(wy);
+}
+
 void ResistanceSystem::clear() {
+  factor_of_a_ = false;
+  lr_w_.clear();
+  lr_k_.clear();
+  lr_ready_ = false;
   if (diagonal_only_) std::fill(diag_.begin(), diag_.end(), 0.0);
   else std::fill(a_.valuePtr(), a_.valuePtr() + a_.nonZeros(), 0.0);
   g_.setZero();
@@ -117,9 +162,8 @@ bool ResistanceSystem::solve(VecX& u) {
     u = g_.array() / Eigen::Map<const VecX>(diag_.data(), g_.size()).array();
     return u.allFinite();
   }
-  ++factorisations_;
-  if (!llt_->factorize(a_)) return false;
-  u = llt_->solve(g_);
+  if (!prepare()) return false;
+  u = apply_inverse(g_);
   return u.allFinite();
 }
 
@@ -131,10 +175,9 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
     u = g_.array() / diag;
     u1 = b_.array() / diag;
   } else {
-    ++factorisations_;
-    if (!llt_->factorize(a_)) return false;
-    u = llt_->solve(g_);
-    u1 = llt_->solve(b_);
+    if (!prepare()) return false;
+    u = apply_inverse(g_);
+    u1 = apply_inverse(b_);
   }
   // Schur complement of the bordered system [[A, b], [b^T, c]].
   const double schur = c_ - b_.dot(u1);
@@ -157,6 +200,7 @@ double ResistanceSystem::residual(const VecX& u, double v) const {
   } else {
     au = a_.selfadjointView<Eigen::Lower>() * u;
   }
+  for (std::size_t c = 0; c < lr_w_.size(); ++c) au += lr_k_[c] * lr_w_[c].dot(u) * lr_w_[c];
   au += v * b_;
   const double gn = g_.norm();
   return (au - g_).norm() / (gn > 0 ? gn : 1.0);

@@ -50,7 +50,12 @@ class Dynamics {
   // explicitly, no tangential stiffness) but whose solved slip v runs against its spring is not
   // sliding in this step: it is marked sticking so that a re-solve gives it its tangential
   // stiffness. Returns how many contacts changed (0: the sliding set is consistent with v).
-  int stick_reversed_sliding(const Velocities& v);
+  // switched (optional): the indices of those contacts in neighbours().pairs().
+  int stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched = nullptr);
+  // Solve again after stick_reversed_sliding at the same positions and dt: the new tangential
+  // stiffness enters as low-rank terms on the last factor (ForceBalance::resolve_with_sticking).
+  bool resolve_with_sticking(double dt_implicit, const std::vector<std::size_t>& switched,
+                             Velocities& v);
   // Largest step the limits allow for these velocities (fixed_dt if set); *which says which.
   double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
   // fixed_dt, shortened on the last step so that a run ends exactly at limits().end_time.

@@ -84,6 +84,7 @@ class ImplicitSprings final : public Integrator {
   double next_dt_ = 0.0;
   StepLimit limit_of_next_ = StepLimit::Displacement;
   long redos_ = 0;
+  std::vector<std::size_t> switched_;  // scratch: contacts switched to sticking in a pass
 };
 
 std::unique_ptr<Integrator> make_integrator(IntegratorType type);

@@ -19,6 +19,8 @@ struct PairResistance {
 struct Lubrication {
   double delta = 0.01;
   double h_max = 0.5;
+  // Off: squeeze mode only, so lubrication exerts no torque and needs no rotational unknowns.
+  bool tangential = true;
 
   bool acts(double h) const { return h < h_max; }
   // Coefficients at reduced gap h; h <= 0 (contact) is evaluated at h = 0 (dashpots).

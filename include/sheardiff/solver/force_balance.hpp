@@ -64,6 +64,20 @@ class ForceBalance {
   bool solve(const Particles& p, const Box& box, const ShearFlow& flow,
              const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
              Velocities& out);
+  // Implicit springs: the contacts `switched` (indices into pairs) have just been marked
+  // sticking after a solve at the same positions and dt_implicit; solves again with their
+  // tangential stiffness added as low-rank terms to the factor of the last solve (no new
+  // assembly or factorisation; a full solve() if one of them touches the floating wall).
+  bool resolve_with_sticking(const Particles& p, const Box& box, const ShearFlow& flow,
+                             const std::vector<Pair>& pairs,
+                             const std::vector<std::size_t>& switched, double dt_implicit,
+                             const WallDrive* wall, Velocities& out);
+  // The two halves of solve(), separately for benchmarks: pair terms and matrix, then the
+  // factorisation and back-substitution.
+  void assemble(const Particles& p, const Box& box, const ShearFlow& flow,
+                const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall);
+  bool solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
+                       Velocities& out);
 
   const std::vector<PairTerm>& terms() const { return terms_; }
   const ResistanceSystem& system() const { return system_; }

@@ -1,4 +1,5 @@
 #pragma once
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <cstddef>
 #include <memory>
@@ -45,6 +46,12 @@ class ResistanceSystem {
   bool solve_with_floating_wall(VecX& u, double load, double free_fall_cap, double& v,
                                 bool& capped);
 
+  // After a solve: the matrix becomes A + k w w^T (w over the unknowns) and the right-hand side
+  // g + dg, solved next time with the factor of A by the Woodbury identity (one back-solve per
+  // added term instead of a new factorisation). clear() drops the terms.
+  void add_low_rank(const VecX& w, double k, const VecX& dg);
+  std::size_t low_rank_solves() const { return low_rank_solves_; }
+
   // Diagnostics: relative residual |A U + b V - g| / |g| of the last solve.
   double residual(const VecX& u, double v) const;
   const Eigen::SparseMatrix<double>& matrix() const { return a_; }
@@ -70,8 +77,18 @@ class ResistanceSystem {
   std::vector<int> diag_idx_;   // dof*dof entries per particle (-1 above the diagonal)
   std::vector<int> pair_idx_;   // dof*dof entries per listed pair, -1 for non mobile-mobile
   std::vector<double> diag_;    // diagonal_only storage
+  // Factorise A unless the factor is already A's (low-rank terms pending), then A'^-1 x.
+  bool prepare();
+  VecX apply_inverse(const VecX& x);
+
   std::unique_ptr<SparseCholesky> llt_;
-  std::size_t factorisations_ = 0, analyses_ = 0;
+  std::size_t factorisations_ = 0, analyses_ = 0, low_rank_solves_ = 0;
+  bool factor_of_a_ = false;  // llt_ holds the factor of the current a_
+  std::vector<VecX> lr_w_;    // low-rank terms k w w^T added since the factorisation
+  std::vector<double> lr_k_;
+  Eigen::MatrixXd lr_z_;  // A^-1 W, and the LDLT of diag(1/k) + W^T A^-1 W
+  Eigen::LDLT<Eigen::MatrixXd> lr_s_;
+  bool lr_ready_ = false;
 };
 
 }  // namespace sheardiff

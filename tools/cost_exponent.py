@@ -1,0 +1,33 @@
+#!/usr/bin/env python3
+"""Fitted exponent b of cost = a N^b for every benchmark family of bench_step's JSON output
+(the default frictional variant at N = 250, 1000, 4000), least squares in log-log space.
+
+    OMP_THREAD_LIMIT=1 build/bench/bench_step --benchmark_format=json > step.json
+    /usr/bin/python3 tools/cost_exponent.py step.json
+"""
+import json
+import sys
+
+import numpy as np
+
+
+def main(path):
+    data = json.load(open(path))
+    fams = {}
+    for b in data["benchmarks"]:
+        if b.get("run_type") == "aggregate" or b.get("label") != "frictional":
+            continue
+        name = b["name"].split("/")[0]
+        fams.setdefault(name, []).append((b["N"], b["real_time"], b.get("cpu_time", b["real_time"])))
+    print(f"{'benchmark':24s} " + " ".join(f"{'N=' + str(int(n)):>10s}" for n, _, _ in
+                                           sorted(next(iter(fams.values())))) + "   exponent (cpu)")
+    for name, pts in fams.items():
+        pts.sort()
+        n = np.array([p[0] for p in pts])
+        cpu = np.array([p[2] for p in pts])
+        b = np.polyfit(np.log(n), np.log(cpu), 1)[0] if len(pts) > 1 else float("nan")
+        print(f"{name:24s} " + " ".join(f"{c:8.3f}ms" for c in cpu) + f"   {b:.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
