@@ -93,13 +93,13 @@ VecX ResistanceSystem::apply_inverse(const VecX& x) {
     for (Eigen::Index a = 0; a < r; ++a)
       for (Eigen::Index b = 0; b < r; ++b) s(a, b) = lr_w_[a].dot(lr_z_.col(b));
     for (Eigen::Index a = 0; a < r; ++a) s(a, a) += 1.0 / lr_k_[a];
-    lr_s_.compute(s);
+    lr_s_.emplace(s);
     lr_ready_ = true;
   }
   VecX wy(r);
   for (Eigen::Index a = 0; a < r; ++a) wy[a] = lr_w_[a].dot(y);
   ++low_rank_solves_;
-  return y - lr_z_ * lr_s_.solve(wy);
+  return y - lr_z_ * lr_s_->solve(wy);
 }
 
 void ResistanceSystem::clear() {

@@ -3,6 +3,7 @@
 #include <Eigen/SparseCore>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,9 +75,9 @@ class ResistanceSystem {
   Eigen::SparseMatrix<double> a_;  // lower triangle
   VecX g_, b_;
   double c_ = 0.0, wall_rhs_ = 0.0;
-  std::vector<int> diag_idx_;   // dof*dof entries per particle (-1 above the diagonal)
-  std::vector<int> pair_idx_;   // dof*dof entries per listed pair, -1 for non mobile-mobile
-  std::vector<double> diag_;    // diagonal_only storage
+  std::vector<int> diag_idx_;  // dof*dof entries per particle (-1 above the diagonal)
+  std::vector<int> pair_idx_;  // dof*dof entries per listed pair, -1 for non mobile-mobile
+  std::vector<double> diag_;   // diagonal_only storage
   // Factorise A unless the factor is already A's (low-rank terms pending), then A'^-1 x.
   bool prepare();
   VecX apply_inverse(const VecX& x);
@@ -87,7 +88,9 @@ class ResistanceSystem {
   std::vector<VecX> lr_w_;    // low-rank terms k w w^T added since the factorisation
   std::vector<double> lr_k_;
   Eigen::MatrixXd lr_z_;  // A^-1 W, and the LDLT of diag(1/k) + W^T A^-1 W
-  Eigen::LDLT<Eigen::MatrixXd> lr_s_;
+  // optional: a default-constructed Eigen::LDLT leaves its info flag uninitialised, and moving
+  // the system (Simulation set-up) would read it (UBSan: invalid enum load).
+  std::optional<Eigen::LDLT<Eigen::MatrixXd>> lr_s_;
   bool lr_ready_ = false;
 };
 
