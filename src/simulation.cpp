@@ -1,5 +1,7 @@
 #include "sheardiff/simulation.hpp"
 
+#include "sheardiff/io/atomic_file.hpp"
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -113,20 +115,6 @@ void Simulation::step() {
         dynamics_->steps(), dynamics_->strain()));
 }
 
-namespace {
-
-void write_text_atomically(const std::filesystem::path& file, const std::string& text) {
-  const auto tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("cannot write {}", tmp));
-  }
-  std::filesystem::rename(tmp, file);
-}
-
-}  // namespace
-
 // Only the observers the scene and the config ask for are composed into the run.
 std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
                                                       const std::filesystem::path& out_dir) {
@@ -178,18 +166,6 @@ std::vector<char> read_bytes(const std::filesystem::path& file) {
   return std::vector<char>(std::istreambuf_iterator<char>(in), {});
 }
 
-// Written to a temporary file, flushed to disk, then renamed: a checkpoint is whole or absent.
-void write_bytes_atomically(const std::filesystem::path& file, const std::vector<char>& bytes) {
-  const auto tmp = file.string() + ".tmp";
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error(fmt::format("cannot write {}", tmp));
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() &&
-                  std::fflush(f) == 0 && fsync(fileno(f)) == 0;
-  std::fclose(f);
-  if (!ok) throw std::runtime_error(fmt::format("cannot write {}", tmp));
-  std::filesystem::rename(tmp, file);
-}
-
 }  // namespace
 
 nlohmann::json run_to_directory(const Config& given, const std::filesystem::path& out_dir,
@@ -216,7 +192,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     std::filesystem::remove(checkpoint_file);
     std::filesystem::remove(out_dir / "summary.json");
     std::filesystem::remove(out_dir / "diagnostic.txt");
-    write_text_atomically(out_dir / "config.toml", resolved);
+    write_file_atomically(out_dir / "config.toml", resolved);
   }
   auto observers = make_observers(cfg, out_dir);
 
@@ -273,7 +249,8 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     std::swap(total, elapsed_before);
     serialize(a);
     std::swap(total, elapsed_before);
-    write_bytes_atomically(checkpoint_file, a.bytes());
+    // Whole or absent: a checkpoint is never half-written.
+    write_file_atomically(checkpoint_file, a.bytes().data(), a.bytes().size());
   };
 
   StopSignals signals;
@@ -395,7 +372,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   }
   if (writer) writer->flush();
   writer.reset();
-  write_text_atomically(out_dir / "summary.json", js.dump(2) + "\n");
+  write_file_atomically(out_dir / "summary.json", js.dump(2) + "\n");
   // Finished: the summary marks the run complete and the checkpoint has served its purpose.
   std::filesystem::remove(checkpoint_file);
   return js;

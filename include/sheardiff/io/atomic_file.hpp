@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
@@ -6,6 +7,9 @@ namespace sheardiff {
 
 // Writes to FILE.tmp, flushes it to disk, then renames it over FILE: a reader (or a run killed
 // mid-write) sees the old file or the new one, never a half-written one.
-void write_file_atomically(const std::filesystem::path& file, const std::string& bytes);
+void write_file_atomically(const std::filesystem::path& file, const char* data, std::size_t size);
+inline void write_file_atomically(const std::filesystem::path& file, const std::string& bytes) {
+  write_file_atomically(file, bytes.data(), bytes.size());
+}
 
 }  // namespace sheardiff
