@@ -1,4 +1,6 @@
 #pragma once
+#include <cholmod.h>
+
 #include <Eigen/SparseCore>
 #include <memory>
 #include <string>
@@ -16,6 +18,9 @@ class SparseCholesky {
   virtual Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const = 0;
   virtual const char* name() const = 0;
 };
+
+// The ordering and supernode settings sheardiff uses for CHOLMOD (measured, see the .cpp).
+void tune_cholmod(cholmod_common& c);
 
 // "cholmod": CHOLMOD supernodal LLT (SuiteSparse; fastest, see docs/performance.md);
 // "eigen": Eigen's SimplicialLLT.
