@@ -1,6 +1,7 @@
 // Running sweep points: one point in this process, or a pool of worker processes.
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sched.h>
 #include <spawn.h>
 #include <sys/file.h>
 #include <sys/wait.h>
@@ -10,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 
@@ -76,13 +78,41 @@ struct Worker {
   std::chrono::steady_clock::time_point started;
 };
 
+// Cores this process may run on (its affinity mask: a cgroup or taskset limit counts).
+int usable_cores() {
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) return CPU_COUNT(&set);
+  const long n = sysconf(_SC_NPROCESSORS_ONLN);
+  return n > 0 ? static_cast<int>(n) : 1;
+}
+
+int threads_per_worker() {
+  const char* limit = std::getenv("OMP_THREAD_LIMIT");
+  if (limit == nullptr) return 1;  // sheardiff sets 1 when it is unset (src/app/main.cpp)
+  const int t = std::atoi(limit);
+  return t > 0 ? t : 1;
+}
+
 }  // namespace
+
+std::string oversubscription_warning(int jobs, int threads_per_job, int cores) {
+  if (static_cast<long>(jobs) * threads_per_job <= cores) return {};
+  const int fit = std::max(1, cores / std::max(1, threads_per_job));
+  return fmt::format(
+      "sweep: warning: --jobs {} x OMP_THREAD_LIMIT {} = {} threads on {} cores; the workers will "
+      "share cores, each point runs slower and the sweep does not finish sooner. Use --jobs {} "
+      "(docs/performance.md, \"Threads\").",
+      jobs, threads_per_job, static_cast<long>(jobs) * threads_per_job, cores, fit);
+}
 
 int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe) {
   const auto points = expand_points(spec);
   fs::create_directories(out_dir / "points");
   fs::create_directories(out_dir / "logs");
   const FileLock lock(out_dir / "sweep.lock", "the sweep in " + out_dir.string());
+  if (const std::string w = oversubscription_warning(jobs, threads_per_worker(), usable_cores());
+      !w.empty())
+    fmt::print(stderr, "{}\n", w);
 
   // States first (a foreign directory stops the sweep before anything starts), longest first.
   std::vector<const SweepPoint*> todo;

@@ -153,3 +153,13 @@ TEST(Sweep, FitsRecoverSyntheticPowerLaws) {
   EXPECT_TRUE(g["phi_of_J"].contains("error"));
   EXPECT_TRUE(g["D_vs_phic_minus_phi"].contains("error"));
 }
+
+TEST(Sweep, OversubscribedPoolIsWarnedAbout) {
+  // 2 cores: two single-threaded workers fit, a third or a second thread each does not.
+  EXPECT_EQ(oversubscription_warning(2, 1, 2), "");
+  EXPECT_EQ(oversubscription_warning(1, 2, 2), "");
+  const std::string w = oversubscription_warning(3, 1, 2);
+  EXPECT_NE(w.find("--jobs 3 x OMP_THREAD_LIMIT 1 = 3 threads on 2 cores"), std::string::npos) << w;
+  EXPECT_NE(w.find("Use --jobs 2"), std::string::npos) << w;
+  EXPECT_NE(oversubscription_warning(2, 2, 2).find("Use --jobs 1"), std::string::npos);
+}

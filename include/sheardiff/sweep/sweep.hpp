@@ -58,6 +58,11 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem
 int run_local(const SweepSpec& spec, const std::filesystem::path& out_dir, int jobs,
               const std::filesystem::path& exe);
 
+// The local pool's oversubscription check (docs/performance.md, "Threads"): workers x threads
+// per worker (OMP_THREAD_LIMIT) above the cores this process may use makes every point slower
+// without raising the throughput. Returns the warning to print, or an empty string.
+std::string oversubscription_warning(int jobs, int threads_per_job, int cores);
+
 // Slurm backend: writes DIR/slurm/{array,collect}.sbatch and submits the array (unfinished
 // points only, % throttle) and a collect job depending on it. Returns the two job ids.
 std::pair<std::string, std::string> submit_slurm(const SweepSpec& spec,
