@@ -1,26 +1,25 @@
 #include "sheardiff/simulation.hpp"
 
-#include "sheardiff/io/atomic_file.hpp"
-
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
-#include <atomic>
-#include <csignal>
+#include <functional>
 #include <iterator>
 
+#include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/setup/random_packing.hpp"
-#include <functional>
 
 namespace sheardiff {
 
@@ -70,7 +69,8 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
       throw ConfigError(fmt::format(
           "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
           "eta/P of explicit springs (smallest pair, normal and slip modes, "
-          "model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < {:.3g}, integrator.dt = 0 (adaptive), or "
+          "model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < "
+          "{:.3g}, integrator.dt = 0 (adaptive), or "
           "integrator.type = \"implicit\"",
           origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
           limit));
@@ -138,11 +138,14 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
 namespace {
 
 std::atomic<int> g_stop_signal{0};
-extern "C" void on_stop_signal(int sig) { g_stop_signal.store(sig); }
+extern "C" void on_stop_signal(int sig) {
+  g_stop_signal.store(sig);
+}
 
 // Installs SIGINT/SIGTERM handlers for the lifetime of a run and restores the old ones.
 struct StopSignals {
-  struct sigaction old_int {}, old_term {};
+  struct sigaction old_int {
+  }, old_term{};
   StopSignals() {
     g_stop_signal.store(0);
     struct sigaction sa {};
@@ -204,12 +207,14 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   const auto serialize = [&](Archive& a) {
     std::string magic = kCheckpointMagic, config = resolved;
     a.io(magic);
-    if (magic != kCheckpointMagic) throw std::runtime_error("checkpoint: not a sheardiff checkpoint");
+    if (magic != kCheckpointMagic)
+      throw std::runtime_error("checkpoint: not a sheardiff checkpoint");
     a.io(config);
     if (config != resolved)
       throw ConfigError(fmt::format(
           "--resume {}: the configuration differs from the one the checkpoint was written with "
-          "(see {}/config.toml)", out_dir.string(), out_dir.string()));
+          "(see {}/config.toml)",
+          out_dir.string(), out_dir.string()));
     d.serialize(a);
     sim.serialize_integrator(a);
     for (auto& o : observers) o->serialize(a);
@@ -279,9 +284,12 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     if (const int sig = g_stop_signal.load()) {
       save_checkpoint(seconds());
       if (tty) std::fprintf(stderr, "\n");
-      throw RunInterrupted(sig, fmt::format(
-          "stopped by signal {} at step {} (strain {:.6g}); checkpoint written: resume with "
-          "`sheardiff run CONFIG --resume {}`", sig, d.steps(), d.strain(), out_dir.string()));
+      throw RunInterrupted(
+          sig,
+          fmt::format(
+              "stopped by signal {} at step {} (strain {:.6g}); checkpoint written: resume with "
+              "`sheardiff run CONFIG --resume {}`",
+              sig, d.steps(), d.strain(), out_dir.string()));
     }
     if (!sim.try_step()) stop(health.solver_failure(d, sim.integrator().velocities()));
     if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
@@ -316,12 +324,16 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     // A terminal gets a live line; a batch log gets one line a minute. The trajectory is
     // flushed every half minute so that a killed run leaves readable frames behind.
     const auto since = now - last_print;
-    if ((tty && since > std::chrono::milliseconds(500)) || (!tty && progress && since > std::chrono::seconds(60))) {
+    if ((tty && since > std::chrono::milliseconds(500)) ||
+        (!tty && progress && since > std::chrono::seconds(60))) {
       last_print = now;
       const double el = std::chrono::duration<double>(now - t0).count();
-      const double eta = el * (cfg.run.strain - d.strain()) / std::max(d.strain(), 1e-12);
+      // A pressure cell that has found its steady state stops at steady + measure_strain.
+      double end = cfg.run.strain;
+      for (const auto& o : observers) end = std::min(end, o->planned_end_strain());
+      const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
       std::fprintf(stderr, "%sstrain %.4g / %.4g  steps %ld  %.0f steps/s  ETA %.0f s%s",
-                   tty ? "\r" : "", d.strain(), cfg.run.strain, d.steps(), d.steps() / el, eta,
+                   tty ? "\r" : "", d.strain(), end, d.steps(), d.steps() / el, eta,
                    tty ? "   " : "\n");
     }
     if (writer && now - last_flush > std::chrono::seconds(30)) {

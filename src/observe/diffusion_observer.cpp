@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 
 namespace sheardiff {
@@ -41,8 +42,8 @@ void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
 void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
   const auto n = static_cast<Eigen::Index>(d.particles().n_mobile);
   if (frames_ < 4) {
-    js["analysis_warnings"] = {fmt::format(
-        "no diffusion analysis: only {} frames in the measured window", frames_)};
+    js["analysis_warnings"] = {
+        fmt::format("no diffusion analysis: only {} frames in the measured window", frames_)};
     return;
   }
   // Row-major buffers (one frame per row) mapped as frames x particles.
@@ -65,7 +66,9 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
   nlohmann::json js;
   {
     std::ifstream in(dir / "summary.json");
-    if (!in) throw std::runtime_error(fmt::format("{}: no summary.json (run not finished?)", dir.string()));
+    if (!in)
+      throw std::runtime_error(
+          fmt::format("{}: no summary.json (run not finished?)", dir.string()));
     js = nlohmann::json::parse(in);
   }
   // The measured window: frames from the detection of steady state (pressure cell) or after
@@ -77,16 +80,19 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
   const ObservableSeries strain = read_h5md_observable(traj, "strain");
   std::vector<long> frames;
   for (std::size_t k = 0; k < strain.value.size(); ++k)
-    if (pressure ? strain.value[k] >= from : strain.value[k] > from) frames.push_back(static_cast<long>(k));
+    if (pressure ? strain.value[k] >= from : strain.value[k] > from)
+      frames.push_back(static_cast<long>(k));
   if (frames.size() < 4)
-    throw std::runtime_error(fmt::format("{}: only {} frames in the measured window", dir.string(),
-                                         frames.size()));
+    throw std::runtime_error(
+        fmt::format("{}: only {} frames in the measured window", dir.string(), frames.size()));
   Eigen::MatrixXd y, vy;
   for (std::size_t row = 0; row < frames.size(); ++row) {
     const H5mdFrame f = read_h5md_frame(traj, frames[row]);
     if (f.unwrapped.empty() || f.velocity.empty())
-      throw std::runtime_error(fmt::format("{}: frames lack unwrapped positions or velocities "
-                                           "(output.velocities = false?)", traj.string()));
+      throw std::runtime_error(
+          fmt::format("{}: frames lack unwrapped positions or velocities "
+                      "(output.velocities = false?)",
+                      traj.string()));
     std::vector<std::size_t> mobile;
     for (std::size_t i = 0; i < f.position.size(); ++i)
       if (f.motion.empty() || f.motion[i] == 0) mobile.push_back(i);
@@ -100,15 +106,11 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
           f.velocity[mobile[c]].y() / cfg.flow.j;
     }
   }
-  const DiffusionReport r = analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg));
+  const DiffusionReport r =
+      analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg));
   add_to_summary(r, js);
   write_analysis_file(r, dir / "analysis.h5");
-  const auto tmp = (dir / "summary.json.tmp").string();
-  {
-    std::ofstream out(tmp);
-    out << js.dump(2) << "\n";
-  }
-  std::filesystem::rename(tmp, dir / "summary.json");
+  write_file_atomically(dir / "summary.json", js.dump(2) + "\n");
   return js;
 }
 

@@ -52,9 +52,9 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
   const double a = d.box().lx * lz_;
   const double mu_top = -v.stress.top_wall_fx / a / pressure_;
   const double h = d.height();
-  values.insert(values.end(), {h, bulk_phi(d, exclusion_), mu_top,
-                               v.stress.bottom_wall_fx / a / pressure_,
-                               v.stress.top_wall_fy / a, v.velocities.wall_v});
+  values.insert(values.end(),
+                {h, bulk_phi(d, exclusion_), mu_top, v.stress.bottom_wall_fx / a / pressure_,
+                 v.stress.top_wall_fy / a, v.velocities.wall_v});
   if (steady()) return;
   hist_strain_.push_back(d.strain());
   hist_h_.push_back(h);
@@ -67,8 +67,10 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
   int n1 = 0, n2 = 0;
   for (std::size_t k = 0; k < hist_strain_.size(); ++k) {
     if (hist_strain_[k] < start) continue;
-    if (hist_strain_[k] < mid) h1 += hist_h_[k], m1 += hist_mu_[k], ++n1;
-    else h2 += hist_h_[k], m2 += hist_mu_[k], ++n2;
+    if (hist_strain_[k] < mid)
+      h1 += hist_h_[k], m1 += hist_mu_[k], ++n1;
+    else
+      h2 += hist_h_[k], m2 += hist_mu_[k], ++n2;
   }
   if (n1 < 2 || n2 < 2) return;
   h1 /= n1, h2 /= n2, m1 /= n1, m2 /= n2;
@@ -82,8 +84,10 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
 void PressureCellObserver::on_step(const StepView& v) {
   const Dynamics& d = v.dynamics;
   const double a = d.box().lx * lz_;
-  if (v.velocities.wall_free_fall) ++free_fall_steps_;
-  else max_p_err_ = std::max(max_p_err_, std::abs(v.stress.top_wall_fy / a - pressure_) / pressure_);
+  if (v.velocities.wall_free_fall)
+    ++free_fall_steps_;
+  else
+    max_p_err_ = std::max(max_p_err_, std::abs(v.stress.top_wall_fy / a - pressure_) / pressure_);
   if (!steady()) return;
   const double w = v.dt;
   const double phi = bulk_phi(d, exclusion_);
@@ -124,6 +128,11 @@ void PressureCellObserver::accumulate_profiles(const StepView& v) {
   }
 }
 
+double PressureCellObserver::planned_end_strain() const {
+  if (steady() && steady_cfg_.measure_strain > 0.0) return steady_at_ + steady_cfg_.measure_strain;
+  return Observer::planned_end_strain();
+}
+
 bool PressureCellObserver::done(const Dynamics& d) const {
   return steady() && steady_cfg_.measure_strain > 0.0 &&
          d.strain() >= steady_at_ + steady_cfg_.measure_strain;
@@ -138,9 +147,10 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["wall_free_fall_steps"] = free_fall_steps_;
   if (!steady() || w_ <= 0.0) {
     js["steady"] = false;
-    js["note"] = steady() ? "steady state detected at the last step: nothing measured after it; "
-                            "run longer (run.strain)"
-                          : "steady state not reached: H or mu still drift; run longer (run.strain)";
+    js["note"] = steady()
+                     ? "steady state detected at the last step: nothing measured after it; "
+                       "run longer (run.strain)"
+                     : "steady state not reached: H or mu still drift; run longer (run.strain)";
     js["H"] = d.height();
     js["phi"] = bulk_phi(d, exclusion_);
     return;

@@ -1,4 +1,5 @@
 #pragma once
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -31,6 +32,8 @@ class Observer {
   virtual void on_step(const StepView&) {}
   // Whether the run may stop now (e.g. measured long enough after steady state).
   virtual bool done(const Dynamics&) const { return false; }
+  // The strain at which done() will turn true, once it is known (the progress line's end).
+  virtual double planned_end_strain() const { return std::numeric_limits<double>::infinity(); }
   // Accumulated state, for checkpoints.
   virtual void serialize(Archive& a) { (void)a; }
   // Results into summary.json, tables into the trajectory (writer may be null).
@@ -50,7 +53,8 @@ class RheologyObserver final : public Observer {
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
   void serialize(Archive& a) override {
     a.tag("rheology");
-    for (double* x : {&weight_, &sxy_, &pressure_, &contacts_, &mean_overlap_, &max_overlap_}) a.io(*x);
+    for (double* x : {&weight_, &sxy_, &pressure_, &contacts_, &mean_overlap_, &max_overlap_})
+      a.io(*x);
   }
 
  private:

@@ -19,6 +19,7 @@ class PressureCellObserver final : public Observer {
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void on_step(const StepView& v) override;
   bool done(const Dynamics& d) const override;
+  double planned_end_strain() const override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
 
   void serialize(Archive& a) override {
