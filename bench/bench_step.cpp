@@ -148,12 +148,17 @@ void full_step(benchmark::State& state) {
   const long steps0 = sim.dynamics().steps();
   const auto rebuilds0 = sim.dynamics().neighbours().rebuilds();
   const auto fact0 = sim.dynamics().force_balance().system().factorisations();
+  const auto terms0 = sim.dynamics().force_balance().system().low_rank_terms();
   for (auto _ : state) sim.step();
   const double steps = static_cast<double>(sim.dynamics().steps() - steps0);
   state.counters["rebuilds_per_step"] =
       static_cast<double>(sim.dynamics().neighbours().rebuilds() - rebuilds0) / steps;
   state.counters["factorisations_per_step"] =
       static_cast<double>(sim.dynamics().force_balance().system().factorisations() - fact0) / steps;
+  // Contacts switched to sticking and solved as low-rank terms on the step's factor.
+  state.counters["low_rank_terms_per_step"] =
+      static_cast<double>(sim.dynamics().force_balance().system().low_rank_terms() - terms0) /
+      steps;
   label(state, sim);
 }
 

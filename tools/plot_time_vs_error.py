@@ -6,6 +6,12 @@ and against |mu - mu_ref| (bottom row); each integrator's Pareto front is drawn 
     /usr/bin/python3 tools/plot_time_vs_error.py bench_results/time_vs_error.csv \
         docs/figures/time_vs_error.png
     /usr/bin/python3 tools/plot_time_vs_error.py --table bench_results/time_vs_error.csv
+    /usr/bin/python3 tools/plot_time_vs_error.py --front bench_results/time_vs_error_full.csv
+
+More than four (J, ktilde) cases (the --full grid) are drawn as one row per ktilde and one
+column per J, against |mu - mu_ref| only. --front prints, for each case and integrator, the
+cheapest setting whose window averages are within the tolerances given in front() (the
+statistical scatter of a steady-state average is larger than all of them).
 """
 import csv
 import math
@@ -33,12 +39,25 @@ def pareto(points):
 def main(path, out):
     rows = [r for r in csv.DictReader(open(path)) if r["status"] == "ok" and r["policy"] != "reference"]
     cases = sorted({(float(r["J"]), float(r["ktilde"])) for r in rows}, key=lambda c: (c[1], -c[0]))
-    fig, axes = plt.subplots(2, len(cases), figsize=(4.2 * len(cases), 7.5), squeeze=False)
-    for col, (j, k) in enumerate(cases):
+    metrics = [("rms_dev", "rms deviation after the window (d)"),
+               ("mu_err", "|mu - mu_ref| over the window")]
+    if len(cases) <= 4:
+        fig, axes = plt.subplots(2, len(cases), figsize=(4.2 * len(cases), 7.5), squeeze=False)
+        panels = [(axes[row][col], case, metric) for col, case in enumerate(cases)
+                  for row, metric in enumerate(metrics)]
+    else:
+        js = sorted({c[0] for c in cases}, reverse=True)
+        ks = sorted({c[1] for c in cases})
+        fig, axes = plt.subplots(len(ks), len(js), figsize=(4.2 * len(js), 3.6 * len(ks)), squeeze=False)
+        panels = [(axes[ks.index(k)][js.index(j)], (j, k), metrics[1]) for j, k in cases]
+        for kk in range(len(ks)):
+            for jj in range(len(js)):
+                if (js[jj], ks[kk]) not in cases:
+                    axes[kk][jj].set_visible(False)
+    first = True
+    for ax, (j, k), (key, label) in panels:
         mine = [r for r in rows if float(r["J"]) == j and float(r["ktilde"]) == k]
-        for row, (key, label) in enumerate([("rms_dev", "rms deviation after the window (d)"),
-                                            ("mu_err", "|mu - mu_ref| over the window")]):
-            ax = axes[row][col]
+        if True:
             for integ, colour in COLOURS.items():
                 pts = []
                 for r in mine:
@@ -59,8 +78,9 @@ def main(path, out):
             ax.set_ylabel("CPU s per unit strain")
             ax.set_title(f"J = {j:g}, ktilde = {k:g}")
             ax.grid(True, which="both", alpha=0.3)
-            if col == 0 and row == 0:
+            if first:
                 ax.legend(title="circles adaptive,\nsquares fixed dt", fontsize=8)
+                first = False
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     print(out)
@@ -87,8 +107,48 @@ def table(path):
               f"| {f('mu_err', '+.3f')} | {f('overlap_rel_err', '+.2f')} | {r['limited_by']} |")
 
 
+def front(path, mu_tol=0.005, phi_tol=1e-3, overlap_tol=0.1):
+    """Per (ktilde, J): each integrator's cheapest setting with |mu - ref| <= mu_tol,
+    |phi - ref| <= phi_tol and |max overlap / ref - 1| <= overlap_tol, and the implicit
+    integrator's speed-up over the cheapest explicit one."""
+    rows = [r for r in csv.DictReader(open(path)) if r["status"] == "ok" and r["policy"] != "reference"]
+    print(f"Cheapest setting within |mu - ref| <= {mu_tol:g}, |phi - ref| <= {phi_tol:g}, "
+          f"max overlap within {overlap_tol:.0%} of the reference's:\n")
+    print("| ktilde | J | Euler | Heun | implicit | implicit vs best explicit |")
+    print("|---|---|---|---|---|---|")
+    cases = sorted({(float(r["ktilde"]), float(r["J"])) for r in rows}, key=lambda c: (c[0], -c[1]))
+    skipped = {(float(r["ktilde"]), float(r["J"]), r["integrator"])
+               for r in csv.DictReader(open(path)) if r["status"].startswith("skipped")}
+    for k, j in cases:
+        best = {}
+        for r in rows:
+            if float(r["ktilde"]) != k or float(r["J"]) != j:
+                continue
+            ok = (abs(float(r["mu_err"])) <= mu_tol and abs(float(r["phi_err"])) <= phi_tol
+                  and abs(float(r["overlap_rel_err"])) <= overlap_tol)
+            cost = float(r["cpu_s_per_strain"])
+            if ok and (r["integrator"] not in best or cost < best[r["integrator"]][0]):
+                setting = (f"md {float(r['md']):g}" if r["policy"] == "adaptive"
+                           else f"J dt {float(r['strain_step']):g}")
+                best[r["integrator"]] = (cost, setting, float(r["steps_per_strain"]))
+        cells = []
+        for integ in ("euler", "heun", "implicit"):
+            if integ in best:
+                c, setting, steps = best[integ]
+                cells.append(f"{c:.3g} s ({setting}, {steps:.0f} steps)")
+            elif (k, j, integ) in skipped:
+                cells.append("skipped (> --max-steps)")
+            else:
+                cells.append("none within tolerance")
+        explicit = [best[i][0] for i in ("euler", "heun") if i in best]
+        ratio = f"{min(explicit) / best['implicit'][0]:.1f}x" if explicit and "implicit" in best else "-"
+        print(f"| {k:g} | {j:g} | " + " | ".join(cells) + f" | {ratio} |")
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "--table":
         table(sys.argv[2])
+    elif sys.argv[1] == "--front":
+        front(sys.argv[2])
     else:
         main(sys.argv[1], sys.argv[2] if len(sys.argv) > 2 else "docs/figures/time_vs_error.png")

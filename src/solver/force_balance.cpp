@@ -46,7 +46,8 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
     term.m.setZero();
     term.f.setZero();
     if (lubricated || (contact && lubrication_))
-      term.m = lubrication_->coefficients(term.g.ai, term.g.aj, term.g.h).matrix(term.g.n, term.g.t);
+      term.m =
+          lubrication_->coefficients(term.g.ai, term.g.aj, term.g.h).matrix(term.g.n, term.g.t);
     if (contact) {
       term.f = contact_.spring_force(term.g, friction ? pr.contact.xi : 0.0);
       // Sliding is what the last Coulomb cap decided, not a re-test of |xi| against the new
@@ -58,8 +59,10 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
     Vec3 known = Vec3::Zero();
     if constexpr (kWalls) {
       const Motion mj = p.motion[pr.j];
-      if (mj == Motion::Mobile) known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
-      else if (mj == Motion::FloatingWall) known.x() = wall->vx;
+      if (mj == Motion::Mobile)
+        known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
+      else if (mj == Motion::FloatingWall)
+        known.x() = wall->vx;
       system_.add_pair(k, pr, term.m, term.f, known, mj == Motion::Mobile,
                        mj == Motion::FloatingWall);
     } else {
@@ -67,7 +70,6 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
       system_.add_pair(k, pr, term.m, term.f, known, true, false);
     }
   }
-
 }
 
 bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
@@ -77,14 +79,17 @@ bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& fl
   return solve_assembled(p, flow, wall, out);
 }
 
-bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
-                                         const ShearFlow& flow, const std::vector<Pair>& pairs,
+bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box, const ShearFlow& flow,
+                                         const std::vector<Pair>& pairs,
                                          const std::vector<std::size_t>& switched,
                                          double dt_implicit, const WallDrive* wall,
                                          Velocities& out) {
-  for (std::size_t k : switched)
-    if (p.motion[pairs[k].j] == Motion::FloatingWall)
-      return solve(p, box, flow, pairs, dt_implicit, wall, out);
+  // A fresh assembly reads the contacts' new state: taken when a contact with the floating wall
+  // switched (its column is not a low-rank term), or when the update would cost more
+  // back-substitutions than a factorisation (many switched contacts at large N).
+  bool full = !system_.low_rank_pays(switched.size());
+  for (std::size_t k : switched) full = full || p.motion[pairs[k].j] == Motion::FloatingWall;
+  if (full) return solve(p, box, flow, pairs, dt_implicit, wall, out);
   const int d = system_.dof();
   const double kt = dt_implicit * contact_.kt;
   VecX w, dg;
@@ -128,17 +133,19 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow&
     system_.add_self(static_cast<int>(i), drag, force);
   }
   // Scenes without walls get a loop with no wall branch at all.
-  if (wall) assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
-  else assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
+  if (wall)
+    assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
+  else
+    assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
 }
 
 bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
                                    Velocities& out) {
   double v = 0.0;
   bool capped = false;
-  const bool ok = wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v,
-                                                          capped)
-                       : system_.solve(u_);
+  const bool ok =
+      wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v, capped)
+           : system_.solve(u_);
   out.wall_free_fall = capped;
   if (!ok) return false;
   if (check_residual_) residual_ = system_.residual(u_, v);
@@ -158,8 +165,12 @@ bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, co
           out.u[i] = Vec3(u_[d * i], u_[d * i + 1], w);
         }
         break;
-      case Motion::FixedWall: out.u[i].setZero(); break;
-      case Motion::FloatingWall: out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero(); break;
+      case Motion::FixedWall:
+        out.u[i].setZero();
+        break;
+      case Motion::FloatingWall:
+        out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero();
+        break;
     }
   }
   return true;

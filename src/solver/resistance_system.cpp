@@ -20,8 +20,8 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
   n_ = n_mobile;
   diagonal_only_ = diagonal_only;
   factor_of_a_ = false;
-  lr_w_.clear();
-  lr_k_.clear();
+  lr_.clear();
+  lr_z_cols_ = 0;
   lr_ready_ = false;
   const int d = dof_;
   const auto nu = static_cast<Eigen::Index>(unknowns());
@@ -51,15 +51,15 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
   for (std::size_t i = 0; i < n_; ++i)
     for (int r = 0; r < d; ++r)
       for (int c = 0; c <= r; ++c)
-        diag_idx_[(i * d + r) * d + c] = index(static_cast<int>(d * i + r), static_cast<int>(d * i + c));
+        diag_idx_[(i * d + r) * d + c] =
+            index(static_cast<int>(d * i + r), static_cast<int>(d * i + c));
   pair_idx_.assign(pairs.size() * d * d, -1);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
     if (p.motion[pr.j] != Motion::Mobile) continue;
     const int hi = std::max(pr.i, pr.j), lo = std::min(pr.i, pr.j);
     for (int r = 0; r < d; ++r)
-      for (int c = 0; c < d; ++c)
-        pair_idx_[(k * d + r) * d + c] = index(d * hi + r, d * lo + c);
+      for (int c = 0; c < d; ++c) pair_idx_[(k * d + r) * d + c] = index(d * hi + r, d * lo + c);
   }
   llt_->analyze(a_);
   ++analyses_;
@@ -68,10 +68,27 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
 void ResistanceSystem::add_low_rank(const VecX& w, double k, const VecX& dg) {
   if (!factor_of_a_ || diagonal_only_)
     throw std::logic_error("ResistanceSystem: low-rank terms need the factor of A");
-  lr_w_.push_back(w);
-  lr_k_.push_back(k);
+  LowRankTerm t{{}, k};
+  for (Eigen::Index i = 0; i < w.size(); ++i)
+    if (w[i] != 0.0) t.w.emplace_back(i, w[i]);
+  lr_.push_back(std::move(t));
+  ++low_rank_terms_;
   g_ += dg;
   lr_ready_ = false;
+}
+
+bool ResistanceSystem::low_rank_pays(std::size_t more) const {
+  if (!factor_of_a_ || diagonal_only_) return false;
+  if (max_low_rank_terms_ > 0) return lr_.size() + more <= max_low_rank_terms_;
+  const double ratio = llt_->solves_per_factorisation();
+  // Unknown cost ratio (Eigen's factorisation): always update.
+  return ratio <= 0.0 || static_cast<double>(lr_.size() + more) <= std::max(ratio, 4.0);
+}
+
+double ResistanceSystem::dot(const LowRankTerm& t, const VecX& x) const {
+  double s = 0.0;
+  for (const auto& [i, v] : t.w) s += v * x[i];
+  return s;
 }
 
 bool ResistanceSystem::prepare() {
@@ -83,32 +100,40 @@ bool ResistanceSystem::prepare() {
 
 VecX ResistanceSystem::apply_inverse(const VecX& x) {
   VecX y = llt_->solve(x);
-  if (lr_w_.empty()) return y;
-  // Woodbury: (A + W K W^T)^-1 = A^-1 - Z (K^-1 + W^T Z)^-1 Z^T, Z = A^-1 W.
-  const auto r = static_cast<Eigen::Index>(lr_w_.size());
+  if (lr_.empty()) return y;
+  // Woodbury: (A + W K W^T)^-1 = A^-1 - Z (K^-1 + W^T Z)^-1 Z^T, Z = A^-1 W. The columns of Z
+  // of earlier passes are kept: a pass costs one back-substitution per new term.
+  const auto r = static_cast<Eigen::Index>(lr_.size());
   if (!lr_ready_) {
-    lr_z_.resize(x.size(), r);
-    for (Eigen::Index c = 0; c < r; ++c) lr_z_.col(c) = llt_->solve(lr_w_[c]);
+    lr_z_.conservativeResize(x.size(), r);
+    for (Eigen::Index c = lr_z_cols_; c < r; ++c) {
+      VecX w = VecX::Zero(x.size());
+      for (const auto& [i, v] : lr_[c].w) w[i] = v;
+      lr_z_.col(c) = llt_->solve(w);
+    }
+    lr_z_cols_ = r;
     Eigen::MatrixXd s(r, r);
     for (Eigen::Index a = 0; a < r; ++a)
-      for (Eigen::Index b = 0; b < r; ++b) s(a, b) = lr_w_[a].dot(lr_z_.col(b));
-    for (Eigen::Index a = 0; a < r; ++a) s(a, a) += 1.0 / lr_k_[a];
+      for (Eigen::Index b = 0; b < r; ++b) s(a, b) = dot(lr_[a], lr_z_.col(b));
+    for (Eigen::Index a = 0; a < r; ++a) s(a, a) += 1.0 / lr_[a].k;
     lr_s_.emplace(s);
     lr_ready_ = true;
   }
   VecX wy(r);
-  for (Eigen::Index a = 0; a < r; ++a) wy[a] = lr_w_[a].dot(y);
+  for (Eigen::Index a = 0; a < r; ++a) wy[a] = dot(lr_[a], y);
   ++low_rank_solves_;
   return y - lr_z_ * lr_s_->solve(wy);
 }
 
 void ResistanceSystem::clear() {
   factor_of_a_ = false;
-  lr_w_.clear();
-  lr_k_.clear();
+  lr_.clear();
+  lr_z_cols_ = 0;
   lr_ready_ = false;
-  if (diagonal_only_) std::fill(diag_.begin(), diag_.end(), 0.0);
-  else std::fill(a_.valuePtr(), a_.valuePtr() + a_.nonZeros(), 0.0);
+  if (diagonal_only_)
+    std::fill(diag_.begin(), diag_.end(), 0.0);
+  else
+    std::fill(a_.valuePtr(), a_.valuePtr() + a_.nonZeros(), 0.0);
   g_.setZero();
   b_.setZero();
   c_ = 0.0;
@@ -118,8 +143,10 @@ void ResistanceSystem::clear() {
 void ResistanceSystem::add_self(int i, const Vec3& resistance, const Vec3& force) {
   for (int r = 0; r < dof_; ++r) {
     const std::size_t row = static_cast<std::size_t>(dof_) * i + r;
-    if (diagonal_only_) diag_[row] += resistance[r];
-    else a_.valuePtr()[diag_idx_[(row)*dof_ + r]] += resistance[r];
+    if (diagonal_only_)
+      diag_[row] += resistance[r];
+    else
+      a_.valuePtr()[diag_idx_[(row)*dof_ + r]] += resistance[r];
     g_[static_cast<Eigen::Index>(row)] += force[r];
   }
 }
@@ -200,7 +227,10 @@ double ResistanceSystem::residual(const VecX& u, double v) const {
   } else {
     au = a_.selfadjointView<Eigen::Lower>() * u;
   }
-  for (std::size_t c = 0; c < lr_w_.size(); ++c) au += lr_k_[c] * lr_w_[c].dot(u) * lr_w_[c];
+  for (const LowRankTerm& t : lr_) {
+    const double kwu = t.k * dot(t, u);
+    for (const auto& [i, w] : t.w) au[i] += kwu * w;
+  }
   au += v * b_;
   const double gn = g_.norm();
   return (au - g_).norm() / (gn > 0 ? gn : 1.0);

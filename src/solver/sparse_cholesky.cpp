@@ -50,9 +50,17 @@ class Cholmod final : public SparseCholesky {
   }
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override { return solver_.solve(rhs); }
   const char* name() const override { return "cholmod"; }
+  double solves_per_factorisation() const override {
+    // fl / (4 lnz) is the flop ratio; the factorisation's dense BLAS-3 kernels run ~3x faster
+    // per flop than the triangular solves (bench_step: 2.5 ms against 0.17 ms at N = 1000,
+    // 15 ms against 0.9 ms at N = 4000, i.e. 15-16 solves per factorisation).
+    const cholmod_common& c = const_cast<Solver&>(solver_).cholmod();
+    return c.lnz > 0.0 ? c.fl / (12.0 * c.lnz) : 0.0;
+  }
 
  private:
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> solver_;
+  using Solver = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+  Solver solver_;
 };
 
 }  // namespace

@@ -29,8 +29,8 @@ struct PairTerm {
   Mat6 m = Mat6::Zero();
   Vec6 f = Vec6::Zero();
   Vec3 image_j = Vec3::Zero();
-  bool on = false;      // inside the lubrication range or in contact
-  bool sliding = false; // contact at its Coulomb limit at the start of the step
+  bool on = false;       // inside the lubrication range or in contact
+  bool sliding = false;  // contact at its Coulomb limit at the start of the step
 
   Vec6 force(const Vec3& ui, const Vec3& uj) const {
     Vec6 u;
@@ -40,8 +40,8 @@ struct PairTerm {
 };
 
 struct Velocities {
-  std::vector<Vec3> u;  // every particle: mobile solved, wall particles their body's motion
-  double wall_v = 0.0;  // y velocity of the floating wall
+  std::vector<Vec3> u;          // every particle: mobile solved, wall particles their body's motion
+  double wall_v = 0.0;          // y velocity of the floating wall
   bool wall_free_fall = false;  // V was capped: the wall is not (yet) held by the packing
 };
 
@@ -81,6 +81,9 @@ class ForceBalance {
 
   const std::vector<PairTerm>& terms() const { return terms_; }
   const ResistanceSystem& system() const { return system_; }
+  // Most low-rank terms per factorisation before a re-solve refactorises (0: from the
+  // factorisation's flop count, the default).
+  void set_max_low_rank_terms(std::size_t n) { system_.set_max_low_rank_terms(n); }
   const std::optional<Lubrication>& lubrication() const { return lubrication_; }
   const FrictionalContact& contact() const { return contact_; }
   // |A U + b V - g| / |g| of the last solve.

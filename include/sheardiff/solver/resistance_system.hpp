@@ -51,7 +51,12 @@ class ResistanceSystem {
   // g + dg, solved next time with the factor of A by the Woodbury identity (one back-solve per
   // added term instead of a new factorisation). clear() drops the terms.
   void add_low_rank(const VecX& w, double k, const VecX& dg);
+  // Whether `more` terms on top of the pending ones are cheaper than a new factorisation:
+  // each term costs one back-substitution (its column of A^-1 W is kept between solves).
+  bool low_rank_pays(std::size_t more) const;
+  void set_max_low_rank_terms(std::size_t n) { max_low_rank_terms_ = n; }
   std::size_t low_rank_solves() const { return low_rank_solves_; }
+  std::size_t low_rank_terms() const { return low_rank_terms_; }
 
   // Diagnostics: relative residual |A U + b V - g| / |g| of the last solve.
   double residual(const VecX& u, double v) const;
@@ -83,11 +88,19 @@ class ResistanceSystem {
   VecX apply_inverse(const VecX& x);
 
   std::unique_ptr<SparseCholesky> llt_;
-  std::size_t factorisations_ = 0, analyses_ = 0, low_rank_solves_ = 0;
+  std::size_t factorisations_ = 0, analyses_ = 0, low_rank_solves_ = 0, low_rank_terms_ = 0;
   bool factor_of_a_ = false;  // llt_ holds the factor of the current a_
-  std::vector<VecX> lr_w_;    // low-rank terms k w w^T added since the factorisation
-  std::vector<double> lr_k_;
-  Eigen::MatrixXd lr_z_;  // A^-1 W, and the LDLT of diag(1/k) + W^T A^-1 W
+  // Low-rank terms k w w^T added since the factorisation; w has a few non-zeros (a pair's
+  // unknowns), kept as (index, value).
+  struct LowRankTerm {
+    std::vector<std::pair<Eigen::Index, double>> w;
+    double k;
+  };
+  std::vector<LowRankTerm> lr_;
+  std::size_t max_low_rank_terms_ = 0;
+  double dot(const LowRankTerm& t, const VecX& x) const;
+  Eigen::Index lr_z_cols_ = 0;  // columns of lr_z_ computed (A^-1 w of the first terms)
+  Eigen::MatrixXd lr_z_;        // A^-1 W, and the LDLT of diag(1/k) + W^T A^-1 W
   // optional: a default-constructed Eigen::LDLT leaves its info flag uninitialised, and moving
   // the system (Simulation set-up) would read it (UBSan: invalid enum load).
   std::optional<Eigen::LDLT<Eigen::MatrixXd>> lr_s_;

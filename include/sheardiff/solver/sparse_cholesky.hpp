@@ -17,6 +17,9 @@ class SparseCholesky {
   virtual bool factorize(const Eigen::SparseMatrix<double>& lower) = 0;
   virtual Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const = 0;
   virtual const char* name() const = 0;
+  // Back-substitutions that cost as much as one factorisation of the analysed pattern, from
+  // the analysis' flop counts (0: unknown).
+  virtual double solves_per_factorisation() const { return 0.0; }
 };
 
 // The ordering and supernode settings sheardiff uses for CHOLMOD (measured, see the .cpp).
