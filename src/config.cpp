@@ -1,6 +1,7 @@
 #include "sheardiff/config.hpp"
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,24 +11,29 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 #include <variant>
 
 namespace sheardiff {
 
 const char* to_string(IntegratorType t) {
   switch (t) {
-    case IntegratorType::Implicit: return "implicit";
-    case IntegratorType::Euler: return "euler";
-    case IntegratorType::Heun: return "heun";
+    case IntegratorType::Implicit:
+      return "implicit";
+    case IntegratorType::Euler:
+      return "euler";
+    case IntegratorType::Heun:
+      return "heun";
   }
   return "?";
 }
 const char* to_string(MixRule m) {
   switch (m) {
-    case MixRule::Area: return "area";
-    case MixRule::Volume: return "volume";
-    case MixRule::Number: return "number";
+    case MixRule::Area:
+      return "area";
+    case MixRule::Volume:
+      return "volume";
+    case MixRule::Number:
+      return "number";
   }
   return "?";
 }
@@ -57,8 +63,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 template <typename T>
 KeySpec real(std::string key, T Config::*sec, double T::*field, double lo, double hi, bool lo_open,
              std::string unit, std::string doc, bool hi_open = false) {
-  KeySpec k{std::move(key), Kind::Real, lo, hi, lo_open, hi_open, {}, std::move(unit),
-            std::move(doc), {}, {}};
+  KeySpec k{std::move(key),  Kind::Real,     lo, hi, lo_open, hi_open, {},
+            std::move(unit), std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<double>(v); };
   return k;
@@ -66,14 +72,16 @@ KeySpec real(std::string key, T Config::*sec, double T::*field, double lo, doubl
 template <typename T>
 KeySpec integer(std::string key, T Config::*sec, std::int64_t T::*field, double lo, double hi,
                 std::string unit, std::string doc) {
-  KeySpec k{std::move(key), Kind::Integer, lo, hi, false, false, {}, std::move(unit), std::move(doc), {}, {}};
+  KeySpec k{std::move(key),  Kind::Integer,  lo, hi, false, false, {},
+            std::move(unit), std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::int64_t>(v); };
   return k;
 }
 template <typename T>
 KeySpec boolean(std::string key, T Config::*sec, bool T::*field, std::string doc) {
-  KeySpec k{std::move(key), Kind::Boolean, -kInf, kInf, false, false, {}, "", std::move(doc), {}, {}};
+  KeySpec k{
+      std::move(key), Kind::Boolean, -kInf, kInf, false, false, {}, "", std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<bool>(v); };
   return k;
@@ -88,8 +96,9 @@ KeySpec text(std::string key, T Config::*sec, std::string T::*field, std::string
 KeySpec choice(std::string key, std::vector<std::string> choices, std::string doc,
                std::function<Value(const Config&)> get,
                std::function<void(Config&, const Value&)> set) {
-  return KeySpec{std::move(key), Kind::Choice, -kInf, kInf, false, false, std::move(choices), "",
-                 std::move(doc), std::move(get), std::move(set)};
+  return KeySpec{std::move(key), Kind::Choice,       -kInf, kInf,           false,
+                 false,          std::move(choices), "",    std::move(doc), std::move(get),
+                 std::move(set)};
 }
 
 const std::vector<KeySpec>& schema() {
@@ -112,8 +121,9 @@ const std::vector<KeySpec>& schema() {
         [](const C& c) { return Value{std::string(to_string(c.particles.mix))}; },
         [](C& c, const Value& v) {
           const auto& t = std::get<std::string>(v);
-          c.particles.mix = t == "area" ? MixRule::Area : t == "volume" ? MixRule::Volume
-                                                                          : MixRule::Number;
+          c.particles.mix = t == "area"     ? MixRule::Area
+                            : t == "volume" ? MixRule::Volume
+                                            : MixRule::Number;
         }));
     s.push_back(real("particles.size_ratio", &C::particles, &C::ParticlesCfg::size_ratio, 1.0, 3.0,
                      false, "", "Diameter of large particles over small ones."));
@@ -161,8 +171,8 @@ const std::vector<KeySpec>& schema() {
                               : t == "euler"  ? IntegratorType::Euler
                                               : IntegratorType::Heun;
         }));
-    s.push_back(real("integrator.dt", &C::integrator, &C::Integrator::dt, 0.0, 1e3, false,
-                     "eta/P", "Fixed time step; 0 = adaptive (limits below)."));
+    s.push_back(real("integrator.dt", &C::integrator, &C::Integrator::dt, 0.0, 1e3, false, "eta/P",
+                     "Fixed time step; 0 = adaptive (limits below)."));
     s.push_back(real("integrator.max_displacement", &C::integrator,
                      &C::Integrator::max_displacement, 0.0, 0.1, true, "d",
                      "Adaptive dt: largest non-affine displacement of any particle per step."));
@@ -171,13 +181,13 @@ const std::vector<KeySpec>& schema() {
                      "Adaptive dt: largest closing of any lubricated gap per step, as a fraction "
                      "of (gap + delta a_mean)."));
     s.push_back(real("integrator.max_overlap_change", &C::integrator,
-                     &C::Integrator::max_overlap_change, 0.0, 0.1, true, "d",
-                     "Adaptive dt: largest change of any contact overlap per step."));
-    s.push_back(real("integrator.max_strain_step", &C::integrator,
-                     &C::Integrator::max_strain_step, 0.0, 0.1, true, "1 (strain)",
-                     "Adaptive dt: upper bound gammadot dt."));
-    s.push_back(real("integrator.explicit_safety", &C::integrator,
-                     &C::Integrator::explicit_safety, 0.0, 1.0, true, "",
+                     &C::Integrator::max_overlap_change, 0.0, 0.1, false, "d",
+                     "Adaptive dt: largest change of any contact overlap per step; 0 = "
+                     "min(max_displacement, 10 d / ktilde), ten typical overlaps P d / kn."));
+    s.push_back(real("integrator.max_strain_step", &C::integrator, &C::Integrator::max_strain_step,
+                     0.0, 0.1, true, "1 (strain)", "Adaptive dt: upper bound gammadot dt."));
+    s.push_back(real("integrator.explicit_safety", &C::integrator, &C::Integrator::explicit_safety,
+                     0.0, 1.0, true, "",
                      "Explicit integrators: dt is at most this fraction of the contact "
                      "stability limit 2 R/k."));
     s.push_back(choice(
@@ -213,16 +223,16 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("steady.window", &C::steady, &C::Steady::window, 0.0, 1e4, true, "1 (strain)",
                      "pressure_shear: steady state = no drift of H and mu between the two halves "
                      "of the last window of this strain."));
-    s.push_back(real("steady.h_tolerance", &C::steady, &C::Steady::h_tolerance, 0.0, 1.0, true,
-                     "", "Relative change of mean H allowed between the window halves."));
+    s.push_back(real("steady.h_tolerance", &C::steady, &C::Steady::h_tolerance, 0.0, 1.0, true, "",
+                     "Relative change of mean H allowed between the window halves."));
     s.push_back(real("steady.mu_tolerance", &C::steady, &C::Steady::mu_tolerance, 0.0, 10.0, true,
                      "", "Change of mean mu allowed between the window halves."));
     s.push_back(real("steady.measure_strain", &C::steady, &C::Steady::measure_strain, 0.0, 1e5,
                      false, "1 (strain)",
                      "pressure_shear: strain simulated after steady state, then stop (0 = run to "
                      "run.strain; run.strain always caps the run)."));
-    s.push_back(real("observables.wall_exclusion", &C::observables,
-                     &C::Observables::wall_exclusion, 0.0, 100.0, false, "d",
+    s.push_back(real("observables.wall_exclusion", &C::observables, &C::Observables::wall_exclusion,
+                     0.0, 100.0, false, "d",
                      "pressure_shear: slab next to each wall left out of the bulk phi."));
     s.push_back(real("observables.profile_bin", &C::observables, &C::Observables::profile_bin, 0.0,
                      100.0, true, "d", "Bin width of the phi, u_x and T profiles across the gap."));
@@ -230,10 +240,10 @@ const std::vector<KeySpec>& schema() {
                         "Self-diffusion analysis over the measured window (steady state, or "
                         "after run.transient_strain): MSD, D, dv, VACF, Psi; writes "
                         "DIR/analysis.h5. Off = it costs nothing."));
-    s.push_back(real("analysis.msd_window_lo", &C::analysis, &C::Analysis::msd_window_lo, 0.0,
-                     1e5, false, "1 (strain)", "Start of the MSD fit window (seed: 8)."));
-    s.push_back(real("analysis.msd_window_hi", &C::analysis, &C::Analysis::msd_window_hi, 0.0,
-                     1e5, true, "1 (strain)", "End of the MSD fit window (seed: 15)."));
+    s.push_back(real("analysis.msd_window_lo", &C::analysis, &C::Analysis::msd_window_lo, 0.0, 1e5,
+                     false, "1 (strain)", "Start of the MSD fit window (seed: 8)."));
+    s.push_back(real("analysis.msd_window_hi", &C::analysis, &C::Analysis::msd_window_hi, 0.0, 1e5,
+                     true, "1 (strain)", "End of the MSD fit window (seed: 15)."));
     s.push_back(integer("analysis.reference_times", &C::analysis, &C::Analysis::reference_times, 1,
                         1e8, "", "Reference times t0 of the MSD, drawn in the measured window."));
     s.push_back(real("analysis.vacf_max_lag", &C::analysis, &C::Analysis::vacf_max_lag, 0.0, 1e3,
@@ -250,8 +260,7 @@ const std::vector<KeySpec>& schema() {
                      "a frame); 0 = only on SIGINT/SIGTERM. Resume with --resume DIR."));
     s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
                         "Write DIR/trajectory.h5 (summary.json is always written)."));
-    s.push_back(real("health.max_overlap", &C::health, &C::Health::max_overlap, 0.0, 1.0, true,
-                     "d",
+    s.push_back(real("health.max_overlap", &C::health, &C::Health::max_overlap, 0.0, 1.0, true, "d",
                      "Run health: stop the run (exit 4) when a contact overlaps by more. The "
                      "mean overlap is ~1/ktilde d, so 0.1 d is 10x it at ktilde = 1e2 and 1000x "
                      "at the default 1e4: only a broken step gets there (docs/stability.md)."));
@@ -309,14 +318,17 @@ std::string suggestion(const std::string& key) {
 
 std::string range_text(const KeySpec& k) {
   switch (k.kind) {
-    case Kind::Boolean: return "true or false";
-    case Kind::Text: return "a string";
+    case Kind::Boolean:
+      return "true or false";
+    case Kind::Text:
+      return "a string";
     case Kind::Choice: {
       std::string s = "one of";
       for (const auto& c : k.choices) s += " \"" + c + "\"";
       return s;
     }
-    case Kind::Integer: return fmt::format("an integer in [{:g}, {:g}]", k.lo, k.hi);
+    case Kind::Integer:
+      return fmt::format("an integer in [{:g}, {:g}]", k.lo, k.hi);
     case Kind::Real:
       return fmt::format("a number in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo, k.hi,
                          k.hi_open ? ")" : "]");
@@ -337,24 +349,29 @@ std::string describe(const toml::node& n) {
     // Kept recognisable as a TOML float: 2.0, not 2.
     if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
     os << t;
-  }
-  else if (n.is_table()) os << "a table";
-  else if (n.is_array()) os << "an array";
-  else n.visit([&](const auto& v) { os << v; });
+  } else if (n.is_table())
+    os << "a table";
+  else if (n.is_array())
+    os << "an array";
+  else
+    n.visit([&](const auto& v) { os << v; });
   return os.str();
 }
 
 Value convert(const toml::node& node, const KeySpec& k, const std::string& origin) {
   const auto bad = [&] {
-    fail(origin, k.key, fmt::format("value {} is not allowed; expected {}", describe(node),
-                                    range_text(k)));
+    fail(origin, k.key,
+         fmt::format("value {} is not allowed; expected {}", describe(node), range_text(k)));
   };
   Value v;
   switch (k.kind) {
     case Kind::Real:
-      if (node.is_floating_point()) v = *node.value<double>();
-      else if (node.is_integer()) v = static_cast<double>(*node.value<std::int64_t>());
-      else bad();
+      if (node.is_floating_point())
+        v = *node.value<double>();
+      else if (node.is_integer())
+        v = static_cast<double>(*node.value<std::int64_t>());
+      else
+        bad();
       if (!std::isfinite(std::get<double>(v))) bad();
       break;
     case Kind::Integer:
@@ -372,8 +389,8 @@ Value convert(const toml::node& node, const KeySpec& k, const std::string& origi
       break;
   }
   if (k.kind == Kind::Real || k.kind == Kind::Integer) {
-    const double x = k.kind == Kind::Real ? std::get<double>(v)
-                                          : static_cast<double>(std::get<std::int64_t>(v));
+    const double x =
+        k.kind == Kind::Real ? std::get<double>(v) : static_cast<double>(std::get<std::int64_t>(v));
     if (x < k.lo || x > k.hi || (k.lo_open && x == k.lo) || (k.hi_open && x == k.hi)) bad();
   }
   if (k.kind == Kind::Choice &&
@@ -422,6 +439,14 @@ void check_combinations(const Config& c, const std::string& origin) {
 
 }  // namespace
 
+double overlap_change_limit(const Config& c) {
+  if (c.integrator.max_overlap_change > 0.0) return c.integrator.max_overlap_change;
+  // At ktilde <= 1e4 this is max_displacement (1e-3 d); stiffer contacts overlap less, and a
+  // step that changes an overlap by many times its typical size P d / kn = d / ktilde
+  // overshoots it (ktilde = 1e5, J = 1e-4, 1e-3 d: largest overlap 5x the converged one).
+  return std::min(c.integrator.max_displacement, 10.0 / c.contact.ktilde);
+}
+
 void resolve_defaults(Config& c) {
   if (c.output.frame_strain <= 0.0) c.output.frame_strain = 0.035 * std::pow(c.flow.j, 0.25);
 }
@@ -434,8 +459,8 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
     root = toml::parse(toml_text, origin);
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
-    throw ConfigError(fmt::format("{}:{}:{}: not valid TOML: {}", origin, b.line, b.column,
-                                  e.description()));
+    throw ConfigError(
+        fmt::format("{}:{}:{}: not valid TOML: {}", origin, b.line, b.column, e.description()));
   }
   apply_table(cfg, root, origin);
   for (const auto& o : overrides) {
@@ -502,9 +527,12 @@ std::string config_reference_markdown() {
     std::visit(
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, std::string>) dflt = "\"" + x + "\"";
-          else if constexpr (std::is_same_v<T, bool>) dflt = x ? "true" : "false";
-          else dflt = fmt::format("{:g}", static_cast<double>(x));
+          if constexpr (std::is_same_v<T, std::string>)
+            dflt = "\"" + x + "\"";
+          else if constexpr (std::is_same_v<T, bool>)
+            dflt = x ? "true" : "false";
+          else
+            dflt = fmt::format("{:g}", static_cast<double>(x));
         },
         k.get(def));
     const char* type = k.kind == Kind::Real      ? "real"

@@ -94,7 +94,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.fixed_dt = cfg.integrator.dt;
   lim.max_displacement = cfg.integrator.max_displacement;
   lim.max_gap_fraction = cfg.integrator.max_gap_fraction;
-  lim.max_overlap_change = cfg.integrator.max_overlap_change;
+  lim.max_overlap_change = overlap_change_limit(cfg);
   lim.max_strain_step = cfg.integrator.max_strain_step;
   lim.end_time = cfg.run.strain / cfg.flow.j;
   if (!integrator_->implicit_springs())

@@ -27,8 +27,8 @@ struct Config {
     std::int64_t init_frame = -1;
   } particles;
   struct Flow {
-    double j = 1e-2;   // viscous number = gammadot in units P/eta
-    double lz = 1.0;   // monolayer thickness for stresses and wall load
+    double j = 1e-2;  // viscous number = gammadot in units P/eta
+    double lz = 1.0;  // monolayer thickness for stresses and wall load
   } flow;
   struct Lubrication {
     bool enabled = true;
@@ -46,7 +46,7 @@ struct Config {
     double dt = 0.0;  // 0 = adaptive
     double max_displacement = 1e-3;
     double max_gap_fraction = 0.5;
-    double max_overlap_change = 1e-3;
+    double max_overlap_change = 0.0;  // 0 = overlap_change_limit(): from the contact stiffness
     double max_strain_step = 1e-2;
     double explicit_safety = 0.5;
   } integrator;
@@ -60,7 +60,7 @@ struct Config {
   struct Run {
     double strain = 1.0;
     std::int64_t seed = 1;
-    std::int64_t max_steps = 0;  // 0 = unlimited
+    std::int64_t max_steps = 0;     // 0 = unlimited
     double transient_strain = 0.0;  // averages in summary.json start here
   } run;
   struct Walls {
@@ -78,11 +78,11 @@ struct Config {
     double profile_bin = 0.5;     // d, bin width of the profiles across the gap
   } observables;
   struct Analysis {
-    bool diffusion = true;         // MSD, VACF, dv, Psi, D over the measured window
-    double msd_window_lo = 8.0;    // strain
-    double msd_window_hi = 15.0;   // strain
+    bool diffusion = true;        // MSD, VACF, dv, Psi, D over the measured window
+    double msd_window_lo = 8.0;   // strain
+    double msd_window_hi = 15.0;  // strain
     std::int64_t reference_times = 1000;
-    double vacf_max_lag = 2.0;     // strain
+    double vacf_max_lag = 2.0;  // strain
   } analysis;
   struct Output {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi
@@ -109,6 +109,10 @@ Config load_config(const std::filesystem::path& file,
 // Fills the defaults that depend on other keys (output.frame_strain = 0 -> from J). Done by
 // parse_config; call it on a Config built in code.
 void resolve_defaults(Config& cfg);
+// The adaptive step's limit on the change of a contact overlap per step (d):
+// integrator.max_overlap_change, or when it is 0, min(max_displacement, 10 d / ktilde), i.e.
+// ten typical overlaps P d / kn (docs/performance.md, "Stiff contacts").
+double overlap_change_limit(const Config& cfg);
 // The resolved configuration as TOML (every key, defaults filled in).
 std::string to_toml(const Config& cfg);
 // Markdown table of every key: name, type, default, allowed range, unit, meaning.

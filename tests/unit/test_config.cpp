@@ -326,3 +326,26 @@ TEST(Config, ReferenceTableListsEveryKey) {
 
 }  // namespace
 }  // namespace sheardiff
+
+namespace sheardiff {
+namespace {
+
+TEST(Config, OverlapChangeLimitFollowsTheStiffness) {
+  // 0 (the default) = min(max_displacement, 10 d / ktilde): ten typical overlaps per step.
+  Config c;
+  EXPECT_EQ(c.integrator.max_overlap_change, 0.0);
+  EXPECT_DOUBLE_EQ(overlap_change_limit(c), 1e-3);  // ktilde 1e4: the displacement limit
+  c.contact.ktilde = 1e5;
+  EXPECT_DOUBLE_EQ(overlap_change_limit(c), 1e-4);
+  c.contact.ktilde = 1e3;
+  EXPECT_DOUBLE_EQ(overlap_change_limit(c), 1e-3);
+  c.integrator.max_displacement = 3e-3;
+  EXPECT_DOUBLE_EQ(overlap_change_limit(c), 3e-3);
+  c.integrator.max_overlap_change = 5e-4;  // given explicitly: taken as is
+  EXPECT_DOUBLE_EQ(overlap_change_limit(c), 5e-4);
+  EXPECT_CONTAINS(config_error("[integrator]\nmax_overlap_change = -1e-4\n"),
+                  "integrator.max_overlap_change");
+}
+
+}  // namespace
+}  // namespace sheardiff
