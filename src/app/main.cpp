@@ -182,6 +182,18 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (sweep->parsed()) return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only);
+    if (check->parsed() && sheardiff::is_sweep_file(config_path)) {
+      // A sweep file: every point's config is built and validated (load_sweep), then listed.
+      if (!overrides.empty())
+        throw sheardiff::ConfigError(
+            "--set applies to run configs; a sweep sets keys in [sweep.set]");
+      const auto spec = sheardiff::load_sweep(config_path);
+      const auto points = sheardiff::expand_points(spec);
+      fmt::print("{}: a sweep of {} points over {}, every point's config valid:\n", config_path,
+                 points.size(), spec.base.string());
+      for (const auto& p : points) fmt::print("  {}\n", p.name);
+      return 0;
+    }
     const sheardiff::Config cfg = sheardiff::load_config(config_path, overrides);
     sheardiff::validate_run_inputs(cfg, config_path);
     if (check->parsed()) {

@@ -57,6 +57,15 @@ Config point_config(const SweepSpec& spec, const SweepPoint& p) {
 
 }  // namespace
 
+bool is_sweep_file(const fs::path& file) {
+  try {
+    const toml::table root = toml::parse_file(file.string());
+    return root.contains("sweep");
+  } catch (const toml::parse_error&) {
+    return false;  // the config loader reports the syntax error with its position
+  }
+}
+
 SweepSpec load_sweep(const fs::path& file) {
   SweepSpec spec;
   spec.file = fs::absolute(file);

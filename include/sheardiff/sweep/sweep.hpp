@@ -38,6 +38,8 @@ struct SweepPoint {
 // Reads and checks the sweep file, then builds and validates every point's config before any
 // work starts. Throws ConfigError naming the file and key.
 SweepSpec load_sweep(const std::filesystem::path& file);
+// Whether a TOML file is a sweep file (has a [sweep] table): `sheardiff check` takes both.
+bool is_sweep_file(const std::filesystem::path& file);
 std::vector<SweepPoint> expand_points(const SweepSpec& spec);
 
 std::filesystem::path point_dir(const std::filesystem::path& out_dir, const SweepPoint& p);
