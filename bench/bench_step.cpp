@@ -113,13 +113,18 @@ void assembly(benchmark::State& state) {
   label(state, sim);
 }
 
-// Numeric factorisation alone (symbolic analysis reused), then the back-substitution alone.
-void factorisation(benchmark::State& state) {
-  Simulation& sim = prepared(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+// The step's system assembled at the scene's implicit dt, as the factorisation sees it.
+const sheardiff::ResistanceSystem& assembled(Simulation& sim) {
   auto& d = sim.dynamics();
   d.force_balance().assemble(d.particles(), d.box(), d.flow(), d.neighbours().pairs(),
                              implicit_dt(sim), d.wall_drive());
-  const auto& a = d.force_balance().system().matrix();
+  return d.force_balance().system();
+}
+
+// Numeric factorisation alone (symbolic analysis reused), then the back-substitution alone.
+void factorisation(benchmark::State& state) {
+  Simulation& sim = prepared(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const auto& a = assembled(sim).matrix();
   auto llt = sheardiff::make_sparse_cholesky(sim.config().solver.cholesky);
   llt->analyze(a);
   for (auto _ : state) benchmark::DoNotOptimize(llt->factorize(a));
@@ -128,10 +133,7 @@ void factorisation(benchmark::State& state) {
 
 void back_substitution(benchmark::State& state) {
   Simulation& sim = prepared(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  auto& d = sim.dynamics();
-  d.force_balance().assemble(d.particles(), d.box(), d.flow(), d.neighbours().pairs(),
-                             implicit_dt(sim), d.wall_drive());
-  const auto& rs = d.force_balance().system();
+  const auto& rs = assembled(sim);
   auto llt = sheardiff::make_sparse_cholesky(sim.config().solver.cholesky);
   llt->analyze(rs.matrix());
   llt->factorize(rs.matrix());

@@ -57,30 +57,29 @@ def main(path, out):
     first = True
     for ax, (j, k), (key, label) in panels:
         mine = [r for r in rows if float(r["J"]) == j and float(r["ktilde"]) == k]
-        if True:
-            for integ, colour in COLOURS.items():
-                pts = []
-                for r in mine:
-                    if r["integrator"] != integ:
-                        continue
-                    err = abs(float(r[key]))
-                    cost = float(r["cpu_s_per_strain"])
-                    if not (math.isfinite(err) and err > 0 and math.isfinite(cost)):
-                        continue
-                    pts.append((err, cost))
-                    ax.scatter(err, cost, color=colour, marker=MARKERS[r["policy"]], s=30)
-                front = pareto(pts)
-                if front:
-                    ax.plot(*zip(*front), color=colour, label=integ)
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-            ax.set_xlabel(label)
-            ax.set_ylabel("CPU s per unit strain")
-            ax.set_title(f"J = {j:g}, ktilde = {k:g}")
-            ax.grid(True, which="both", alpha=0.3)
-            if first:
-                ax.legend(title="circles adaptive,\nsquares fixed dt", fontsize=8)
-                first = False
+        for integ, colour in COLOURS.items():
+            pts = []
+            for r in mine:
+                if r["integrator"] != integ:
+                    continue
+                err = abs(float(r[key]))
+                cost = float(r["cpu_s_per_strain"])
+                if not (math.isfinite(err) and err > 0 and math.isfinite(cost)):
+                    continue
+                pts.append((err, cost))
+                ax.scatter(err, cost, color=colour, marker=MARKERS[r["policy"]], s=30)
+            front = pareto(pts)
+            if front:
+                ax.plot(*zip(*front), color=colour, label=integ)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel("CPU s per unit strain")
+        ax.set_title(f"J = {j:g}, ktilde = {k:g}")
+        ax.grid(True, which="both", alpha=0.3)
+        if first:
+            ax.legend(title="circles adaptive,\nsquares fixed dt", fontsize=8)
+            first = False
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     print(out)
