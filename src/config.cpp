@@ -117,7 +117,8 @@ const std::vector<KeySpec>& schema() {
     s.push_back(choice(
         "particles.mix", {"area", "volume", "number"},
         "How small (d) and large (size_ratio d) particles are mixed: equal total area, equal "
-        "total volume, or equal numbers.",
+        "total volume (the default: the seed paper mixes its spheres in equal volume, N_small / "
+        "N_large = size_ratio^3), or equal numbers.",
         [](const C& c) { return Value{std::string(to_string(c.particles.mix))}; },
         [](C& c, const Value& v) {
           const auto& t = std::get<std::string>(v);
@@ -248,6 +249,10 @@ const std::vector<KeySpec>& schema() {
                         1e8, "", "Reference times t0 of the MSD, drawn in the measured window."));
     s.push_back(real("analysis.vacf_max_lag", &C::analysis, &C::Analysis::vacf_max_lag, 0.0, 1e3,
                      true, "1 (strain)", "Longest lag of the velocity autocorrelation."));
+    s.push_back(real("analysis.error_block", &C::analysis, &C::Analysis::error_block, 0.0, 1e5,
+                     true, "1 (strain)",
+                     "Time blocks of the error bars (phi, mu, dv, Psi, D): longer than the "
+                     "correlation time (>= 10 Psi); at least 4 blocks are used."));
     s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, false,
                      "1 (strain)",
                      "Strain between two trajectory frames; 0 = 0.035 J^(1/4), i.e. 10 frames per "

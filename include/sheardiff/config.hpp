@@ -19,7 +19,7 @@ struct Config {
   } scene;
   struct ParticlesCfg {
     std::int64_t n = 500;
-    MixRule mix = MixRule::Area;
+    MixRule mix = MixRule::Volume;  // the seed (Appendix A): "mixed in equal volume"
     double size_ratio = 1.4;
     double phi_init = 0.7;
     double aspect = 1.0;  // Ly / Lx of the initial cell
@@ -83,6 +83,7 @@ struct Config {
     double msd_window_hi = 15.0;  // strain
     std::int64_t reference_times = 1000;
     double vacf_max_lag = 2.0;  // strain
+    double error_block = 3.0;   // strain: time blocks of the error bars
   } analysis;
   struct Output {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi

@@ -219,24 +219,30 @@ Persistence persistence_time(const Autocorrelation& ac) {
   if (!(out.c0 > 0.0)) {
     throw std::invalid_argument(fmt::format("persistence_time: C(0) = {} must be > 0", out.c0));
   }
-  out.psi_e = std::numeric_limits<double>::quiet_NaN();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.psi_e = nan;
+  out.psi_zero = nan;
   const double inv_e = std::exp(-1.0);
   double prev = 1.0;  // C / C(0) at the previous lag
   for (std::size_t k = 1; k < ac.c.size(); ++k) {
     const double t0 = ac.lag[k - 1], t1 = ac.lag[k];
     const double cur = ac.c[k] / out.c0;
+    out.psi_full += 0.5 * (prev + cur) * (t1 - t0);
     if (std::isnan(out.psi_e) && cur <= inv_e) {
       out.psi_e = t0 + (t1 - t0) * (prev - inv_e) / (prev - cur);
     }
-    if (cur <= 0.0) {
-      // Stop at the interpolated crossing: beyond it C is noise whose integral only adds
-      // variance (and a spurious sign).
-      const double tc = t0 + (t1 - t0) * prev / (prev - cur);
-      out.psi += 0.5 * prev * (tc - t0);
-      out.crossed_zero = true;
-      break;
+    if (!out.crossed_zero) {
+      if (cur <= 0.0) {
+        // psi stops at the interpolated crossing: beyond it C is noise whose integral only
+        // adds variance (and a spurious sign).
+        const double tc = t0 + (t1 - t0) * prev / (prev - cur);
+        out.psi += 0.5 * prev * (tc - t0);
+        out.psi_zero = tc;
+        out.crossed_zero = true;
+      } else {
+        out.psi += 0.5 * (prev + cur) * (t1 - t0);
+      }
     }
-    out.psi += 0.5 * (prev + cur) * (t1 - t0);
     prev = cur;
   }
   return out;

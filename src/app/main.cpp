@@ -67,9 +67,12 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
     const auto& f = g["fits"];
     fmt::print("  {}:", g["axes"].dump());
     for (const char* k : {"D_vs_J", "dv_vs_J", "psi_vs_J"})
-      if (f[k].contains("b"))
-        fmt::print(" {} = {:.3g} J^{:.3f}+-{:.3f};", k, f[k]["a"].get<double>(),
-                   f[k]["b"].get<double>(), f[k]["b_stderr"].get<double>());
+      if (f[k].contains("b")) {
+        // The quoted error is the seeds' scatter: none with one seed per J.
+        const auto& e = f[k]["b_stderr"];
+        fmt::print(" {} = {:.3g} J^{:.3f}{};", k, f[k]["a"].get<double>(), f[k]["b"].get<double>(),
+                   e.is_number() ? fmt::format("+-{:.3f}", e.get<double>()) : "");
+      }
     if (f["phi_of_J"].contains("phi_c"))
       fmt::print(" phi = {:.4f} - {:.3g} J^{:.3f}", f["phi_of_J"]["phi_c"].get<double>(),
                  f["phi_of_J"]["a"].get<double>(), f["phi_of_J"]["b"].get<double>());
@@ -173,11 +176,11 @@ int main(int argc, char** argv) {
       const auto js = sheardiff::reanalyse_run(run_dir);
       fmt::print(
           "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
-          "(log-log slope {:.3f}); dv = {:.4g} gammadot d; Psi = {:.4g} / gammadot; "
-          "step length {:.4g} d\n",
-          run_dir, num(js, "D"), num(js, "D_stderr"), num_at(js, "msd_window", 0),
-          num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"), num(js, "psi"),
-          num(js, "step_length"));
+          "(log-log slope {:.3f}); dv = {:.4g} +- {:.2g} gammadot d; Psi = {:.4g} +- {:.2g} / "
+          "gammadot; step length {:.4g} d\n",
+          run_dir, num(js, "D"), num(js, "D_err"), num_at(js, "msd_window", 0),
+          num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"),
+          num(js, "dv_err"), num(js, "psi"), num(js, "psi_err"), num(js, "step_length"));
       print_warnings(js);
       return 0;
     }
@@ -220,9 +223,10 @@ int main(int argc, char** argv) {
                    num(summary, "phi"));
       } else {
         fmt::print(
-            "  steady from strain {:.3g}: phi = {:.4f} +- {:.4f}, mu = {:.4f}, H = {:.3f} d\n",
-            num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_std"),
-            num(summary, "mu"), num(summary, "H"));
+            "  steady from strain {:.3g}: phi = {:.4f} +- {:.2g}, mu = {:.4f} +- {:.2g}, H = "
+            "{:.3f} d (+- statistical errors, time blocks)\n",
+            num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_err"),
+            num(summary, "mu"), num(summary, "mu_err"), num(summary, "H"));
         fmt::print(
             "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
             "held steps)\n",
@@ -237,10 +241,11 @@ int main(int argc, char** argv) {
     }
     if (summary.contains("D"))
       fmt::print(
-          "  diffusion: D = {:.4g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
-          "gammadot d, Psi = {:.4g} / gammadot\n",
-          num(summary, "D"), num_at(summary, "msd_window", 0), num_at(summary, "msd_window", 1),
-          num(summary, "dv"), num(summary, "psi"));
+          "  diffusion: D = {:.4g} +- {:.2g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
+          "+- {:.2g} gammadot d, Psi = {:.4g} +- {:.2g} / gammadot\n",
+          num(summary, "D"), num(summary, "D_err"), num_at(summary, "msd_window", 0),
+          num_at(summary, "msd_window", 1), num(summary, "dv"), num(summary, "dv_err"),
+          num(summary, "psi"), num(summary, "psi_err"));
     print_warnings(summary);
     return 0;
   } catch (const sheardiff::RunUnhealthy& e) {

@@ -29,10 +29,7 @@ void Dynamics::rebuild() {
 
 double Dynamics::height() const {
   if (!walls_) return box_.ly;
-  double top = 0.0, bottom = 0.0;
-  for (int k : walls_->top) top += particles_.position[k].y();
-  for (int k : walls_->bottom) bottom += particles_.position[k].y();
-  return top / walls_->top.size() - bottom / walls_->bottom.size();
+  return mean_height(particles_, walls_->top) - mean_height(particles_, walls_->bottom);
 }
 
 void Dynamics::begin_step() {

@@ -7,6 +7,7 @@
 
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/observe/pressure_cell.hpp"
 
 namespace sheardiff {
 
@@ -16,6 +17,7 @@ DiffusionSettings diffusion_settings(const Config& cfg) {
   s.window_hi = cfg.analysis.msd_window_hi;
   s.reference_times = cfg.analysis.reference_times;
   s.vacf_max_lag = cfg.analysis.vacf_max_lag;
+  s.error_block = cfg.analysis.error_block;
   s.seed = static_cast<std::uint64_t>(cfg.run.seed);
   return s;
 }
@@ -25,7 +27,8 @@ DiffusionObserver::DiffusionObserver(const Config& cfg, std::filesystem::path an
     : settings_(diffusion_settings(cfg)),
       frame_strain_(cfg.output.frame_strain),
       file_(std::move(analysis_file)),
-      measuring_(std::move(measuring)) {}
+      measuring_(std::move(measuring)),
+      exclusion_(cfg.observables.wall_exclusion) {}
 
 void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
   const Dynamics& d = v.dynamics;
@@ -35,6 +38,10 @@ void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
   for (std::size_t i = 0; i < p.n_mobile; ++i) {
     y_.push_back(p.unwrapped[i].y());
     vy_.push_back(v.velocities.u[i].y() / gd);
+  }
+  if (d.walls()) {
+    bottom_.push_back(mean_height(p, d.walls()->bottom));
+    top_.push_back(mean_height(p, d.walls()->top));
   }
   ++frames_;
 }
@@ -50,8 +57,13 @@ void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const Eigen::MatrixXd y = Eigen::Map<const RowMajor>(y_.data(), frames_, n);
   const Eigen::MatrixXd vy = Eigen::Map<const RowMajor>(vy_.data(), frames_, n);
+  Eigen::MatrixXd mask;
+  if (static_cast<long>(bottom_.size()) == frames_ && frames_ > 0)
+    mask = bulk_mask(y, Eigen::Map<const Eigen::VectorXd>(bottom_.data(), frames_),
+                     Eigen::Map<const Eigen::VectorXd>(top_.data(), frames_), exclusion_);
   try {
-    const DiffusionReport r = analyse_diffusion(y, vy, frame_strain_, settings_);
+    const DiffusionReport r =
+        analyse_diffusion(y, vy, frame_strain_, settings_, mask.size() ? &mask : nullptr);
     add_to_summary(r, js);
     if (!file_.empty()) write_analysis_file(r, file_);
   } catch (const std::invalid_argument& e) {
@@ -86,6 +98,10 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
     throw std::runtime_error(
         fmt::format("{}: only {} frames in the measured window", dir.string(), frames.size()));
   Eigen::MatrixXd y, vy;
+  Eigen::VectorXd bottom(static_cast<Eigen::Index>(frames.size())), top(bottom.size());
+  bool walls = false;
+  GapProfiles profiles(cfg.observables.profile_bin);
+  double height_sum = 0;
   for (std::size_t row = 0; row < frames.size(); ++row) {
     const H5mdFrame f = read_h5md_frame(traj, frames[row]);
     if (f.unwrapped.empty() || f.velocity.empty())
@@ -105,10 +121,45 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
       vy(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(c)) =
           f.velocity[mobile[c]].y() / cfg.flow.j;
     }
+    // Wall centre lines (fixed bottom, floating top) for the bulk-only analysis and profiles.
+    double yb = 0, yt = 0;
+    long nb = 0, nt = 0;
+    for (std::size_t i = 0; i < f.motion.size(); ++i) {
+      if (f.motion[i] == static_cast<int>(Motion::FixedWall)) yb += f.position[i].y(), ++nb;
+      if (f.motion[i] == static_cast<int>(Motion::FloatingWall)) yt += f.position[i].y(), ++nt;
+    }
+    if (nb > 0 && nt > 0) {
+      walls = true;
+      bottom(static_cast<Eigen::Index>(row)) = yb / static_cast<double>(nb);
+      top(static_cast<Eigen::Index>(row)) = yt / static_cast<double>(nt);
+      Particles p;
+      p.n_mobile = mobile.size();
+      std::vector<Vec3> u;
+      for (std::size_t c = 0; c < mobile.size(); ++c) {
+        p.position.push_back(f.position[mobile[c]]);
+        p.radius.push_back(0.5 * f.diameter[mobile[c]]);
+        u.push_back(f.velocity[mobile[c]]);
+      }
+      const double h = top(static_cast<Eigen::Index>(row)) - bottom(static_cast<Eigen::Index>(row));
+      height_sum += h;
+      profiles.add(p, u, bottom(static_cast<Eigen::Index>(row)), h, f.lx, 1.0);
+    }
   }
-  const DiffusionReport r =
-      analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg));
+  Eigen::MatrixXd mask;
+  if (walls) mask = bulk_mask(y, bottom, top, cfg.observables.wall_exclusion);
+  const DiffusionReport r = analyse_diffusion(y, vy, cfg.output.frame_strain,
+                                              diffusion_settings(cfg), walls ? &mask : nullptr);
   add_to_summary(r, js);
+  if (pressure) {
+    // The steady window's error bars and profiles from the frames (a run measures its profiles
+    // every step; these are frame averages over the same window).
+    const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
+    add_steady_errors(js, strain.value, series("H"), series("phi"), series("mu_top"),
+                      series("mu_bottom"), from, strain.value.back(), cfg.analysis.error_block);
+    if (walls)
+      profiles.to_summary(js, cfg.flow.j, height_sum / static_cast<double>(frames.size()),
+                          cfg.observables.wall_exclusion);
+  }
   write_analysis_file(r, dir / "analysis.h5");
   write_file_atomically(dir / "summary.json", js.dump(2) + "\n");
   return js;

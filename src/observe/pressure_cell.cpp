@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sheardiff/analysis/power_law.hpp"
+#include "sheardiff/analysis/uncertainty.hpp"
 #include "sheardiff/io/h5md.hpp"
 
 namespace sheardiff {
@@ -16,25 +18,96 @@ double disc_area_between(double yc, double a, double y1, double y2) {
   return y2 > y1 ? below(y2) - below(y1) : 0.0;
 }
 
-namespace {
-double mean_y(const Particles& p, const std::vector<int>& ids) {
-  double s = 0.0;
-  for (int k : ids) s += p.position[k].y();
-  return s / static_cast<double>(ids.size());
+void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb, double height,
+                      double lx, double weight) {
+  lx_ = lx;
+  const std::size_t need = static_cast<std::size_t>(std::ceil((height + 2.0) / bin_));
+  if (w_.size() < need)
+    for (auto* vec : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_}) vec->resize(need, 0.0);
+  for (double& x : w_) x += weight;
+  const auto bins = static_cast<long>(w_.size());
+  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+    const double y = p.position[i].y() - yb, a = p.radius[i];
+    const auto lo = static_cast<long>(std::floor((y - a) / bin_));
+    const auto hi = static_cast<long>(std::floor((y + a) / bin_));
+    for (long b = std::max(0L, lo); b <= hi && b < bins; ++b)
+      area_[b] += weight * disc_area_between(y, a, b * bin_, (b + 1) * bin_);
+    const long c = static_cast<long>(std::floor(y / bin_));
+    if (c < 0 || c >= bins) continue;
+    const Vec3& v = u[i];
+    n_[c] += weight;
+    ux_[c] += weight * v.x();
+    ux2_[c] += weight * v.x() * v.x();
+    uy2_[c] += weight * v.y() * v.y();
+  }
 }
-}  // namespace
+
+Eigen::MatrixXd GapProfiles::table() const {
+  const auto nb = static_cast<Eigen::Index>(w_.size());
+  Eigen::MatrixXd t(nb, 4);
+  for (Eigen::Index b = 0; b < nb; ++b) {
+    const double n = n_[b];
+    const double ux = n > 0 ? ux_[b] / n : 0.0;
+    t(b, 0) = (static_cast<double>(b) + 0.5) * bin_;
+    t(b, 1) = w_[b] > 0 ? area_[b] / (w_[b] * lx_ * bin_) : 0.0;
+    t(b, 2) = ux;
+    t(b, 3) = n > 0 ? ux2_[b] / n - ux * ux + uy2_[b] / n : 0.0;
+  }
+  return t;
+}
+
+void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
+                             double exclusion) const {
+  if (empty() || !(gammadot > 0.0)) return;
+  const Eigen::MatrixXd t = table();
+  std::vector<double> y, phi, ux, temp, yb, uxb;
+  for (Eigen::Index b = 0; b < t.rows(); ++b) {
+    y.push_back(t(b, 0));
+    phi.push_back(t(b, 1));
+    ux.push_back(t(b, 2) / gammadot);
+    temp.push_back(t(b, 3) / (gammadot * gammadot));
+    if (n_[b] > 0 && t(b, 0) >= exclusion && t(b, 0) <= height - exclusion)
+      yb.push_back(t(b, 0)), uxb.push_back(t(b, 2) / gammadot);
+  }
+  js["profile_y"] = y;
+  js["profile_phi"] = phi;
+  js["profile_u_x"] = ux;  // in gammadot d (the imposed flow is y)
+  js["profile_T"] = temp;  // in (gammadot d)^2
+  js["profile_bin"] = bin_;
+  if (yb.size() >= 3) js["bulk_shear_rate_ratio"] = fit_line(yb, uxb).slope;
+}
+
+void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
+                       const std::vector<double>& h, const std::vector<double>& phi,
+                       const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
+                       double from, double to, double block) {
+  if (!(to > from) || strain.size() < 8) return;
+  const long blocks = std::max(4L, static_cast<long>((to - from) / block));
+  std::vector<double> mu(mu_top.size());
+  for (std::size_t k = 0; k < mu.size(); ++k) mu[k] = 0.5 * (mu_top[k] + mu_bottom[k]);
+  const auto err = [&](const std::vector<double>& x) {
+    const double e = batch_means(strain, x, from, to, blocks).err;
+    return std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr);
+  };
+  js["H_err"] = err(h);
+  js["phi_err"] = err(phi);
+  js["mu_err"] = err(mu);
+  js["mu_top_err"] = err(mu_top);
+  js["mu_bottom_err"] = err(mu_bottom);
+}
 
 PressureCellObserver::PressureCellObserver(const Config& cfg)
     : steady_cfg_(cfg.steady),
       exclusion_(cfg.observables.wall_exclusion),
-      bin_(cfg.observables.profile_bin),
       pressure_(1.0),
       lz_(cfg.flow.lz),
-      run_strain_(cfg.run.strain) {}
+      run_strain_(cfg.run.strain),
+      error_block_(cfg.analysis.error_block),
+      profiles_(cfg.observables.profile_bin) {}
 
 double PressureCellObserver::bulk_phi(const Dynamics& d, double exclusion) {
   const Particles& p = d.particles();
-  const double yb = mean_y(p, d.walls()->bottom), yt = mean_y(p, d.walls()->top);
+  const double yb = mean_height(p, d.walls()->bottom), yt = mean_height(p, d.walls()->top);
   double y1 = yb + exclusion, y2 = yt - exclusion;
   if (y2 - y1 < 1.0) y1 = yb, y2 = yt;  // a thin cell has no bulk: use the whole gap
   double area = 0.0;
@@ -55,7 +128,14 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
   values.insert(values.end(),
                 {h, bulk_phi(d, exclusion_), mu_top, v.stress.bottom_wall_fx / a / pressure_,
                  v.stress.top_wall_fy / a, v.velocities.wall_v});
-  if (steady()) return;
+  if (steady()) {
+    s_strain_.push_back(d.strain());
+    s_h_.push_back(h);
+    s_phi_.push_back(values[values.size() - 5]);
+    s_mu_top_.push_back(mu_top);
+    s_mu_bottom_.push_back(values[values.size() - 3]);
+    return;
+  }
   hist_strain_.push_back(d.strain());
   hist_h_.push_back(h);
   hist_mu_.push_back(mu_top);
@@ -98,34 +178,7 @@ void PressureCellObserver::on_step(const StepView& v) {
   mu_top_ += w * (-v.stress.top_wall_fx / a / pressure_);
   mu_bottom_ += w * (v.stress.bottom_wall_fx / a / pressure_);
   p_meas_ += w * v.stress.top_wall_fy / a;
-  accumulate_profiles(v);
-}
-
-void PressureCellObserver::accumulate_profiles(const StepView& v) {
-  const Dynamics& d = v.dynamics;
-  const Particles& p = d.particles();
-  const double yb = d.flow().y0;
-  const std::size_t need = static_cast<std::size_t>(std::ceil((d.height() + 2.0) / bin_));
-  if (prof_w_.size() < need) {
-    for (auto* vec : {&prof_w_, &prof_area_, &prof_n_, &prof_ux_, &prof_ux2_, &prof_uy2_})
-      vec->resize(need, 0.0);
-  }
-  const double w = v.dt;
-  for (double& x : prof_w_) x += w;
-  for (std::size_t i = 0; i < p.n_mobile; ++i) {
-    const double y = p.position[i].y() - yb, a = p.radius[i];
-    const auto lo = static_cast<long>(std::floor((y - a) / bin_));
-    const auto hi = static_cast<long>(std::floor((y + a) / bin_));
-    for (long b = std::max(0L, lo); b <= hi && b < static_cast<long>(need); ++b)
-      prof_area_[b] += w * disc_area_between(y, a, b * bin_, (b + 1) * bin_);
-    const long c = static_cast<long>(std::floor(y / bin_));
-    if (c < 0 || c >= static_cast<long>(need)) continue;
-    const Vec3& u = v.velocities.u[i];
-    prof_n_[c] += w;
-    prof_ux_[c] += w * u.x();
-    prof_ux2_[c] += w * u.x() * u.x();
-    prof_uy2_[c] += w * u.y() * u.y();
-  }
+  profiles_.add(d.particles(), v.velocities.u, d.flow().y0, d.height(), d.box().lx, w);
 }
 
 double PressureCellObserver::planned_end_strain() const {
@@ -164,19 +217,12 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["mu_bottom"] = mu_bottom_ / w_;
   js["pressure_measured"] = p_meas_ / w_;
   js["measured_strain"] = d.strain() - steady_at_;
-  if (writer && !prof_w_.empty()) {
-    const auto nb = static_cast<Eigen::Index>(prof_w_.size());
-    Eigen::MatrixXd t(nb, 4);
-    for (Eigen::Index b = 0; b < nb; ++b) {
-      const double n = prof_n_[b];
-      const double ux = n > 0 ? prof_ux_[b] / n : 0.0;
-      t(b, 0) = (b + 0.5) * bin_;
-      t(b, 1) = prof_area_[b] / (prof_w_[b] * d.box().lx * bin_);
-      t(b, 2) = ux;
-      t(b, 3) = n > 0 ? prof_ux2_[b] / n - ux * ux + prof_uy2_[b] / n : 0.0;
-    }
-    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, t);
-  }
+  add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, d.strain(),
+                    error_block_);
+  profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
+  if (writer && !profiles_.empty())
+    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, profiles_.table());
+
 }
 
 }  // namespace sheardiff

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -151,9 +152,61 @@ json fit_group(const std::vector<json>& rows) {
   return fits;
 }
 
+// Fit errors from the scatter between seeds: every replicate draws, at each J, as many runs as
+// there are with replacement, averages them, and refits. Returns {fit: {param: sd}} over the
+// replicates (null where a fit failed in more than 5 % of them or there is one run per J).
+json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replicates) {
+  bool several = false;
+  for (const auto& [j, runs] : by_j) several = several || runs.size() > 1;
+  if (!several) return json::object();
+  std::mt19937_64 rng(20261201);
+  std::map<std::string, std::vector<double>> samples;
+  const char* params[] = {"a", "b", "phi_c", "mu_c"};
+  long done = 0;
+  for (long r = 0; r < replicates; ++r) {
+    std::vector<json> rows;
+    for (const auto& [j, runs] : by_j) {
+      json row{{"J", j}};
+      std::vector<std::size_t> pick;
+      for (std::size_t k = 0; k < runs.size(); ++k) pick.push_back(rng() % runs.size());
+      for (const char* q : {"phi", "mu", "D", "dv", "psi"}) {
+        double sum = 0;
+        long n = 0;
+        for (std::size_t k : pick)
+          if (const double v = num(runs[k], q); std::isfinite(v)) sum += v, ++n;
+        row[q] = n > 0 ? json(sum / static_cast<double>(n)) : json(nullptr);
+      }
+      rows.push_back(row);
+    }
+    const json fits = fit_group(rows);
+    ++done;
+    for (const auto& [name, f] : fits.items())
+      for (const char* q : params)
+        if (f.contains(q) && f[q].is_number()) samples[name + "." + q].push_back(f[q].get<double>());
+  }
+  json out = json::object();
+  for (const auto& [key, v] : samples) {
+    const auto dot = key.find('.');
+    const std::string fit = key.substr(0, dot), param = key.substr(dot + 1);
+    if (static_cast<double>(v.size()) < 0.95 * static_cast<double>(done)) {
+      out[fit][param] = nullptr;
+      continue;
+    }
+    double m = 0, s2 = 0;
+    for (double x : v) m += x / static_cast<double>(v.size());
+    for (double x : v) s2 += (x - m) * (x - m);
+    out[fit][param] = std::sqrt(s2 / static_cast<double>(v.size() - 1));
+  }
+  return out;
+}
+
 json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
-  if (!fs::is_directory(out_dir / "points"))
-    throw ConfigError(fmt::format("{}: no sweep there (no points/ folder)", out_dir.string()));
+  if (!fs::is_directory(out_dir / "points") &&
+      (spec.results.empty() || !fs::is_directory(spec.results / "points")))
+    throw ConfigError(fmt::format("{}: no sweep there (no points/ folder{})", out_dir.string(),
+                                  spec.results.empty() ? ""
+                                                       : " and no stored results in " +
+                                                             spec.results.string()));
   const auto points = expand_points(spec);
   std::vector<std::map<std::string, json>> table;
   std::set<std::string> summary_keys;
@@ -164,12 +217,18 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   for (const auto& p : points) {
     std::map<std::string, json> row;
     row["point"] = p.name;
-    const auto dir = point_dir(out_dir, p);
+    auto dir = point_dir(out_dir, p);
     json summary;
     std::string status = "missing";
+    // A finished run directory is stored first; a point finished elsewhere is read from the
+    // store. A finished point whose config differs from the sweep's is an error, not a row.
+    const bool here = fs::exists(dir / "summary.json") &&
+                      point_state(spec, p, out_dir) == PointState::finished;
+    if (here) export_point(spec, p, out_dir);
+    if (!here)
+      if (const auto stored = stored_point(spec, p); !stored.empty()) dir = stored;
     if (fs::exists(dir / "summary.json")) {
-      // A finished point whose config differs from the sweep's is an error, not a row.
-      if (point_state(spec, p, out_dir) == PointState::finished) {
+      if (here || dir != point_dir(out_dir, p)) {
         std::ifstream in(dir / "summary.json");
         summary = json::parse(in);
         status = "done";
@@ -229,10 +288,15 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
     }
     csv << fmt::format("{}\n", fmt::join(cells, ","));
   }
+  fs::create_directories(out_dir);
   write_file_atomically(out_dir / "sweep.csv", csv.str());
+  if (!spec.results.empty()) {
+    fs::create_directories(spec.results);
+    write_file_atomically(spec.results / "sweep.csv", csv.str());
+  }
 
   json fits;
-  fits["sweep"] = spec.file.string();
+  fits["sweep"] = spec.file.filename().string();
   fits["points"] = points.size();
   fits["finished"] = finished;
   fits["seed_table1"] = seed_reference();
@@ -258,15 +322,39 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
         }
         const double mean = s / n;
         r[q] = mean;
+        // The scatter between seeds (null with one seed), and what the runs' own error bars
+        // predict for it (their rms over sqrt(n)): the two agree if the error bars are right.
         r[std::string(q) + "_sem"] =
-            n > 1 ? std::sqrt(std::max(0.0, (s2 - n * mean * mean) / (n - 1)) / n) : 0.0;
+            n > 1 ? json(std::sqrt(std::max(0.0, (s2 - n * mean * mean) / (n - 1)) / n))
+                  : json(nullptr);
+        double e2 = 0;
+        long ne = 0;
+        for (const auto& run : runs)
+          if (const double e = num(run, (std::string(q) + "_err").c_str()); std::isfinite(e))
+            e2 += e * e, ++ne;
+        r[std::string(q) + "_run_err"] =
+            ne > 0 ? json(std::sqrt(e2 / ne) / std::sqrt(static_cast<double>(ne)))
+                   : json(nullptr);
       }
       rows.push_back(r);
     }
-    fits["groups"].push_back(
-        {{"axes", group_axes[key]}, {"rows", rows}, {"fits", fit_group(rows)}});
+    json group_fits = fit_group(rows);
+    // Quoted errors: the seed bootstrap's; the regressions' own stay as *_regression_stderr.
+    const json boot = seed_bootstrap(by_j, 2000);
+    for (auto& [name, f] : group_fits.items()) {
+      if (f.contains("error")) continue;
+      for (const char* q : {"a", "b", "phi_c", "mu_c"}) {
+        const std::string se = std::string(q) + "_stderr";
+        if (!f.contains(q)) continue;
+        if (f.contains(se)) f[std::string(q) + "_regression_stderr"] = f[se];
+        f[se] = boot.contains(name) && boot[name].contains(q) ? boot[name][q] : json(nullptr);
+      }
+      f["errors"] = boot.contains(name) ? "seed bootstrap" : "none: one seed per J";
+    }
+    fits["groups"].push_back({{"axes", group_axes[key]}, {"rows", rows}, {"fits", group_fits}});
   }
   write_file_atomically(out_dir / "fits.json", fits.dump(2) + "\n");
+  if (!spec.results.empty()) write_file_atomically(spec.results / "fits.json", fits.dump(2) + "\n");
   return fits;
 }
 

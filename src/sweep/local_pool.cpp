@@ -61,6 +61,7 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_d
   // in it can be continued, and a stale trajectory must not survive into the new run.
   if (state == PointState::fresh) fs::remove_all(dir);
   run_to_directory(cfg, dir, true, state == PointState::resumable);
+  export_point(spec, p, out_dir);
 }
 
 namespace {

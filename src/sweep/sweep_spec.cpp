@@ -81,7 +81,7 @@ SweepSpec load_sweep(const fs::path& file) {
   const auto* sweep = root["sweep"].as_table();
   if (!sweep) throw ConfigError(fmt::format("{}: missing the [sweep] table", origin));
   const std::string w = origin + ": sweep";
-  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes"}, w);
+  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes", "results"}, w);
 
   const auto base = get_or<std::string>(*sweep, "base", "", w);
   if (base.empty()) throw ConfigError(fmt::format("{}.base: missing (the base config file)", w));
@@ -90,6 +90,11 @@ SweepSpec load_sweep(const fs::path& file) {
   if (!fs::exists(spec.base))
     throw ConfigError(
         fmt::format("{}.base = \"{}\": no such file ({})", w, base, spec.base.string()));
+
+  if (const auto results = get_or<std::string>(*sweep, "results", "", w); !results.empty())
+    spec.results = (fs::path(results).is_absolute() ? fs::path(results)
+                                                    : spec.file.parent_path() / results)
+                       .lexically_normal();
 
   spec.jobs = static_cast<int>(get_or<int64_t>(*sweep, "jobs", 2, w));
   if (spec.jobs < 1 || spec.jobs > 256)
@@ -212,6 +217,9 @@ fs::path point_dir(const fs::path& out_dir, const SweepPoint& p) {
 
 PointState point_state(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
   const auto dir = point_dir(out_dir, p);
+  // Finished on another machine or in an earlier session: its results are stored.
+  if (!fs::exists(dir / "summary.json") && !stored_point(spec, p).empty())
+    return PointState::finished;
   if (!fs::exists(dir / "config.toml")) return PointState::fresh;
   // Compared through the parser, so keys added to the code since the point ran (defaults) do
   // not make a finished point look foreign.

@@ -29,12 +29,20 @@ rows = sorted(g["rows"], key=lambda r: r["J"])
 f = g["fits"]
 for name in ("D_vs_J", "dv_vs_J", "psi_vs_J", "D_vs_phic_minus_phi", "dv_vs_phic_minus_phi",
              "psi_vs_phic_minus_phi"):
-    for k in ("a", "a_stderr", "b", "b_stderr", "n", "r2"):
+    for k in ("a", "a_regression_stderr", "b", "b_regression_stderr", "n", "r2"):
         assert k in f[name], f"fits.{name} lacks {k}: {f[name]}"
         assert math.isfinite(f[name][k]), f"fits.{name}.{k} = {f[name][k]}"
 for name, crit in (("phi_of_J", "phi_c"), ("mu_of_J", "mu_c")):
-    for k in (crit, crit + "_stderr", "a", "b", "a_stderr", "b_stderr"):
+    for k in (crit, crit + "_regression_stderr", "a", "b", "a_regression_stderr",
+              "b_regression_stderr"):
         assert math.isfinite(f[name][k]), f"fits.{name}.{k} = {f[name].get(k)}"
+# One seed per J: the quoted (seed-bootstrap) errors are null and say why, never the
+# regression's (which ignores the scatter between independent runs).
+for name, fit in f.items():
+    if "error" in fit:
+        continue
+    assert fit["errors"] == "none: one seed per J", f"fits.{name}.errors = {fit.get('errors')}"
+    assert fit["b_stderr"] is None, f"fits.{name}.b_stderr = {fit['b_stderr']}"
 
 phi = [r["phi"] for r in rows]
 dv = [r["dv"] for r in rows]

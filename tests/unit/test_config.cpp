@@ -89,7 +89,7 @@ TEST(Config, EmptyDocumentGivesTheDefaults) {
   // The documented defaults (model.md section 10 and docs/config.md).
   EXPECT_EQ(cfg.scene.type, "simple_shear");
   EXPECT_EQ(cfg.particles.n, 500);
-  EXPECT_EQ(cfg.particles.mix, MixRule::Area);
+  EXPECT_EQ(cfg.particles.mix, MixRule::Volume);
   EXPECT_EQ(cfg.particles.size_ratio, 1.4);
   EXPECT_EQ(cfg.flow.j, 1e-2);
   EXPECT_EQ(cfg.flow.lz, 1.0);

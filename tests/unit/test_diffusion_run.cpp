@@ -30,7 +30,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   ASSERT_TRUE(during.contains("D"));
   ASSERT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
   const nlohmann::json after = reanalyse_run(dir);
-  for (const char* key : {"D", "D_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
+  for (const char* key : {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
                           "msd_window_slope", "analysis_frames", "diffusion_consistency"})
     EXPECT_EQ(during[key], after[key]) << key;
   // Physical sanity of the numbers themselves: a sheared suspension diffuses and fluctuates.

@@ -163,3 +163,63 @@ TEST(Sweep, OversubscribedPoolIsWarnedAbout) {
   EXPECT_NE(w.find("Use --jobs 2"), std::string::npos) << w;
   EXPECT_NE(oversubscription_warning(2, 2, 2).find("Use --jobs 1"), std::string::npos);
 }
+
+namespace {
+
+// A finished point: its config and a summary on the law D = 0.024 J^-1/4 (x noise), etc.
+void fake_finished(const SweepSpec& spec, const SweepPoint& p, const fs::path& out, double noise) {
+  const auto dir = point_dir(out, p);
+  fs::create_directories(dir);
+  const Config cfg = load_config(spec.base, p.overrides);
+  std::ofstream(dir / "config.toml") << to_toml(cfg);
+  const double J = cfg.flow.j;
+  const nlohmann::json s = {{"J", J},
+                            {"steady", true},
+                            {"phi", 0.81 - 0.64 * std::sqrt(J) + 0.002 * noise},
+                            {"mu", 0.3 + 0.9 * std::pow(J, 0.4)},
+                            {"D", 0.024 * std::pow(J, -0.25) * (1 + 0.1 * noise)},
+                            {"D_err", 0.1},
+                            {"dv", 0.26 * std::pow(J, -0.25) * (1 + 0.02 * noise)},
+                            {"psi", 0.35 * std::pow(J, 0.25) * (1 + 0.05 * noise)}};
+  std::ofstream(dir / "summary.json") << s.dump();
+}
+
+}  // namespace
+
+TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
+  const auto file = write_files("store",
+                                "[sweep]\nbase = \"base.toml\"\nresults = \"stored\"\n"
+                                "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
+                                "\"run.seed\" = [1, 2, 3]\n");
+  const auto spec = load_sweep(file);
+  EXPECT_EQ(spec.results, file.parent_path() / "stored");
+  const auto points = expand_points(spec);
+  const auto out = file.parent_path() / "out";
+  const double noise[] = {-1.0, 0.3, 0.7};
+  for (const auto& p : points) fake_finished(spec, p, out, noise[p.index % 3]);
+  const auto fits = collect_sweep(spec, out);
+  EXPECT_EQ(fits["finished"].get<long>(), 12);
+  const auto& f = fits["groups"][0]["fits"];
+  // Quoted errors come from the scatter between seeds (bootstrap), the regression's are kept.
+  EXPECT_EQ(f["D_vs_J"]["errors"], "seed bootstrap");
+  EXPECT_GT(f["D_vs_J"]["a_stderr"].get<double>(), 0.0);
+  EXPECT_TRUE(f["D_vs_J"].contains("b_regression_stderr"));
+  // The per-J rows hold the seeds' scatter and what the runs' own errors predict for it.
+  EXPECT_NEAR(fits["groups"][0]["rows"][0]["D_run_err"].get<double>(), 0.1 / std::sqrt(3.0),
+              1e-12);
+  // Every point is stored; without the run directories the stored points are finished and
+  // the same fits come back from the store alone.
+  for (const auto& p : points) {
+    EXPECT_TRUE(fs::exists(spec.results / "points" / p.name / "summary.json"));
+    EXPECT_FALSE(stored_point(spec, p).empty());
+  }
+  EXPECT_TRUE(fs::exists(spec.results / "fits.json"));
+  fs::remove_all(out);
+  EXPECT_EQ(point_state(spec, points[0], out), PointState::finished);
+  const auto again = collect_sweep(spec, file.parent_path() / "elsewhere");
+  EXPECT_EQ(again["groups"], fits["groups"]);
+  // A store of another configuration is never reused.
+  std::ofstream(spec.results / "points" / points[0].name / "config.toml")
+      << to_toml(load_config(spec.base, points[5].overrides));
+  EXPECT_THROW(stored_point(spec, points[0]), ConfigError);
+}

@@ -49,9 +49,14 @@ Autocorrelation velocity_autocorrelation(const Eigen::MatrixXd& v, double dt, lo
 // interpolated; crossed_zero = true) or to the last lag (crossed_zero = false): the caller sets
 // the cut-off through max_lag. psi_e = first time C / C(0) reaches 1/e (linear interpolation),
 // NaN if it never does. c0 = C(0) = dv^2. Throws if C(0) <= 0 or fewer than 2 lags.
+// Two more definitions, for comparing with papers that use them: psi_zero = the first zero
+// crossing time itself (NaN if C stays positive), psi_full = the integral of C / C(0) over every
+// lag given (the Green-Kubo value, D / dv^2 once the lags reach the diffusive regime).
 struct Persistence {
   double psi = 0;
   double psi_e = 0;
+  double psi_zero = 0;
+  double psi_full = 0;
   bool crossed_zero = false;
   double c0 = 0;
 };

@@ -35,4 +35,11 @@ struct Particles {
   }
 };
 
+// Mean centre height of the particles ids (a wall's centre line); 0 for no ids.
+inline double mean_height(const Particles& p, const std::vector<int>& ids) {
+  double s = 0.0;
+  for (int k : ids) s += p.position[static_cast<std::size_t>(k)].y();
+  return ids.empty() ? 0.0 : s / static_cast<double>(ids.size());
+}
+
 }  // namespace sheardiff

@@ -23,7 +23,7 @@ class DiffusionObserver final : public Observer {
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
   void serialize(Archive& a) override {
     a.tag("diffusion");
-    a.io(y_), a.io(vy_), a.io(frames_);
+    a.io(y_), a.io(vy_), a.io(frames_), a.io(bottom_), a.io(top_);
   }
 
  private:
@@ -33,6 +33,8 @@ class DiffusionObserver final : public Observer {
   std::function<bool(const Dynamics&)> measuring_;
   std::vector<double> y_, vy_;
   long frames_ = 0;
+  double exclusion_;
+  std::vector<double> bottom_, top_;  // wall centre lines per frame (scenes with walls)
 };
 
 // Recomputes the diffusion analysis of a finished run from DIR/trajectory.h5, DIR/config.toml

@@ -19,6 +19,10 @@ struct SweepSpec {
   std::vector<std::pair<std::string, std::vector<std::string>>> axes;
   int jobs = 2;
   std::string backend = "local";
+  // Optional: where finished points' small results persist (summary.json, config.toml,
+  // analysis.h5; no trajectories), e.g. results/<sweep name> in the repository. Points found
+  // there count as finished, and --collect works from it alone (docs/sweeps.md).
+  std::filesystem::path results;
   struct Slurm {
     int throttle = 0;  // at most this many array tasks at once; 0 = no limit
     std::string time = "1-00:00:00", partition, job_name = "sheardiff";
@@ -71,8 +75,17 @@ std::pair<std::string, std::string> submit_slurm(const SweepSpec& spec,
                                                  const std::filesystem::path& out_dir,
                                                  const std::filesystem::path& exe);
 
-// Reads every point's summary.json and writes DIR/sweep.csv and DIR/fits.json (atomically).
-// Returns fits.json.
+// Copies a finished point's small results (summary.json, config.toml, analysis.h5) into
+// spec.results/points/<name>/ (each file atomically; nothing if spec.results is empty or the
+// point is not finished in out_dir). Returns whether it copied.
+bool export_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
+// The stored results of a point: spec.results/points/<name>/ if it holds a summary.json of
+// this point's config, else an empty path.
+std::filesystem::path stored_point(const SweepSpec& spec, const SweepPoint& p);
+
+// Reads every point's summary.json (from DIR/points, or from the stored results when the run
+// directory lacks it), exports finished points to spec.results, and writes DIR/sweep.csv and
+// DIR/fits.json (atomically; also into spec.results). Returns fits.json.
 nlohmann::json collect_sweep(const SweepSpec& spec, const std::filesystem::path& out_dir);
 
 // The fits of one group of runs (same ktilde, N, ...): power laws of D, dv, Psi against J and

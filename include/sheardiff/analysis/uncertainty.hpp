@@ -1,0 +1,69 @@
+#pragma once
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "sheardiff/analysis/time_series.hpp"
+
+namespace sheardiff {
+
+// Statistical errors of one run's measured quantities from the run's own data (docs/numerics.md,
+// "Error bars"). All three estimators cut the measured window into consecutive time blocks
+// longer than the correlation time of what they average, so that blocks are close to
+// independent while particles inside a block may be correlated in any way (collective motion
+// is what makes independent runs scatter more than a particle count suggests).
+
+// Mean of samples x taken at times t (ascending) from t_from on, and its standard error from
+// the scatter of the means of `blocks` equal blocks of time (batch means). err is NaN when
+// fewer than 2 blocks hold samples.
+struct BatchMeans {
+  double mean = 0, err = 0;
+  long blocks = 0;
+  std::vector<double> block_means;
+};
+BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& x, double t_from,
+                       double t_to, long blocks);
+
+// The MSD-slope diffusion coefficient D of frames y (frames x particles, spacing dt), fitted
+// over lags [lo, hi] by OLS of MSD against lag using every frame as a reference time, and its
+// variance. The estimator is a quadratic form in the frame-to-frame increments,
+// D = sum_kl W_kl G_kl with G = (increments) (increments)^T summed over particles, so its
+// variance splits exactly into terms between different time blocks and terms inside one
+// block. Between blocks: the Rademacher wild-bootstrap variance sum_{B<B'} (2 Q_BB')^2, exact
+// in expectation when increments of different blocks are uncorrelated. Inside a block: from the
+// covariance, over blocks, of the block's increment products at each separation (stationary
+// statistics). Tested for coverage on random walks, Ornstein-Uhlenbeck walks and walks with a
+// common collective mode (tests/unit/test_uncertainty.cpp).
+struct MsdSlopeError {
+  double d = 0;           // the all-reference-times estimate on these frames
+  double err = 0;         // sqrt(var_between + var_within)
+  double var_between = 0, var_within = 0;
+  long blocks = 0, block_frames = 0, increments_used = 0;
+};
+MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, double hi,
+                              long block_frames);
+
+// The velocity autocorrelation of v (frames x particles) summed separately for each block of
+// reference times (origins in the block, partners up to max_lag later, possibly in the next
+// block), optionally weighted by mask (same shape, 0/1: whether particle i at origin t counts,
+// e.g. "in the bulk"). The sums over all blocks give the usual C(tau); leaving one block out
+// gives the delete-one-block jackknife. Psi (every definition) and dv with their errors come
+// from that jackknife.
+struct PersistenceEstimate {
+  Autocorrelation c;    // C(tau) over all origins (mask-weighted)
+  double dv = 0, dv_err = 0;
+  Persistence p;        // from c
+  double psi_err = 0, psi_e_err = 0, psi_zero_err = 0, psi_full_err = 0;
+  long blocks = 0;
+};
+PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt, long max_lag,
+                                            long block_frames,
+                                            const Eigen::MatrixXd* mask = nullptr);
+
+// MSD over the given reference frames counting particle i at origin t0 only where
+// mask(t0, i) != 0 (the bulk-only MSD); the unmasked overload is in time_series.hpp.
+MsdResult masked_mean_square_displacement(const Eigen::MatrixXd& y, const Eigen::MatrixXd& mask,
+                                          double dt, long max_lag,
+                                          const std::vector<long>& reference_frames);
+
+}  // namespace sheardiff

@@ -1,0 +1,257 @@
+#include "sheardiff/analysis/uncertainty.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace sheardiff {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Delete-one jackknife standard error of leave-one-out values x (NaN if any is not finite).
+double jackknife_err(const std::vector<double>& x) {
+  const auto n = static_cast<double>(x.size());
+  if (x.size() < 2) return kNaN;
+  double mean = 0;
+  for (double v : x) {
+    if (!std::isfinite(v)) return kNaN;
+    mean += v / n;
+  }
+  double s = 0;
+  for (double v : x) s += (v - mean) * (v - mean);
+  return std::sqrt((n - 1.0) / n * s);
+}
+
+}  // namespace
+
+BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& x, double t_from,
+                       double t_to, long blocks) {
+  if (t.size() != x.size())
+    throw std::invalid_argument(
+        fmt::format("batch_means: {} times but {} samples", t.size(), x.size()));
+  if (blocks < 1 || !(t_to > t_from))
+    throw std::invalid_argument(fmt::format(
+        "batch_means: need blocks >= 1 and t_to > t_from (got {}, [{}, {}])", blocks, t_from, t_to));
+  BatchMeans out;
+  std::vector<double> sum(static_cast<std::size_t>(blocks), 0.0);
+  std::vector<long> count(static_cast<std::size_t>(blocks), 0);
+  const double width = (t_to - t_from) / static_cast<double>(blocks);
+  double total = 0;
+  long n = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (t[k] < t_from || t[k] > t_to || !std::isfinite(x[k])) continue;
+    const auto b = std::min(blocks - 1, static_cast<long>((t[k] - t_from) / width));
+    sum[static_cast<std::size_t>(b)] += x[k];
+    ++count[static_cast<std::size_t>(b)];
+    total += x[k];
+    ++n;
+  }
+  out.mean = n > 0 ? total / static_cast<double>(n) : kNaN;
+  for (long b = 0; b < blocks; ++b)
+    if (count[static_cast<std::size_t>(b)] > 0)
+      out.block_means.push_back(sum[static_cast<std::size_t>(b)] /
+                                static_cast<double>(count[static_cast<std::size_t>(b)]));
+  out.blocks = static_cast<long>(out.block_means.size());
+  if (out.blocks < 2) {
+    out.err = kNaN;
+    return out;
+  }
+  double m = 0;
+  for (double v : out.block_means) m += v;
+  m /= static_cast<double>(out.blocks);
+  double s = 0;
+  for (double v : out.block_means) s += (v - m) * (v - m);
+  out.err = std::sqrt(s / static_cast<double>(out.blocks - 1) / static_cast<double>(out.blocks));
+  return out;
+}
+
+MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, double hi,
+                              long block_frames) {
+  if (!(dt > 0.0) || block_frames < 2 || y.cols() < 1)
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: need dt > 0, block_frames >= 2 and particles (got {}, {}, {})", dt,
+        block_frames, y.cols()));
+  const long increments = static_cast<long>(y.rows()) - 1;
+  MsdSlopeError out;
+  out.block_frames = block_frames;
+  out.blocks = increments / block_frames;
+  if (out.blocks < 2)
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: {} increments make fewer than 2 blocks of {}", increments,
+        block_frames));
+  // Whole blocks only: the estimate is that of the first blocks * block_frames increments.
+  const long n = out.blocks * block_frames;
+  const long frames = n + 1;
+  out.increments_used = n;
+  const double particles = static_cast<double>(y.cols());
+
+  // OLS slope weights of MSD(L) over the window's lags: slope = sum_L c_L MSD(L), D = slope/2.
+  std::vector<long> lags;
+  const double tol = 1e-9;
+  for (long L = std::max(1L, static_cast<long>(std::ceil(lo / dt - tol)));
+       L <= std::min(frames - 1, static_cast<long>(std::floor(hi / dt + tol))); ++L)
+    lags.push_back(L);
+  if (lags.size() < 3)
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: the window [{}, {}] holds {} lags of {} frames, need 3", lo, hi,
+        lags.size(), frames));
+  double tbar = 0;
+  for (long L : lags) tbar += static_cast<double>(L) * dt / static_cast<double>(lags.size());
+  double sxx = 0;
+  for (long L : lags) sxx += std::pow(static_cast<double>(L) * dt - tbar, 2);
+  std::vector<double> weight(lags.size());
+  for (std::size_t i = 0; i < lags.size(); ++i)
+    weight[i] = (static_cast<double>(lags[i]) * dt - tbar) / (2.0 * sxx) /
+                (particles * static_cast<double>(frames - lags[i]));
+
+  // W(k, k + s): how much the product of increments k and k + s weighs in D. MSD(L) counts it
+  // once per reference time t0 whose window [t0, t0 + L) holds both.
+  const auto w_of = [&](long k, long s) {
+    double w = 0;
+    for (std::size_t i = 0; i < lags.size(); ++i) {
+      const long L = lags[i];
+      if (s >= L) continue;
+      const long first = std::max(0L, k + s - L + 1), last = std::min(k, frames - 1 - L);
+      if (last >= first) w += weight[i] * static_cast<double>(last - first + 1);
+    }
+    return w;
+  };
+  Eigen::MatrixXd inc = y.middleRows(1, n) - y.topRows(n);
+  const Eigen::MatrixXd g = inc * inc.transpose();  // summed over particles
+  inc.resize(0, 0);
+  Eigen::MatrixXd w(n, n);
+  for (long k = 0; k < n; ++k)
+    for (long s = 0; k + s < n; ++s) w(k, k + s) = w(k + s, k) = w_of(k, s);
+
+  const long nb = out.blocks, b = block_frames;
+  // Q(B, B') = sum over k in B, l in B' of W G; D = sum over all block pairs.
+  Eigen::MatrixXd q(nb, nb);
+  for (long B = 0; B < nb; ++B)
+    for (long C = 0; C < nb; ++C)
+      q(B, C) = (w.block(B * b, C * b, b, b).array() * g.block(B * b, C * b, b, b).array()).sum();
+  out.d = q.sum();
+  for (long B = 0; B < nb; ++B)
+    for (long C = B + 1; C < nb; ++C) out.var_between += std::pow(2.0 * q(B, C), 2);
+
+  // Inside a block: Q_BB ~ sum_s wbar_B(s) h_B(s), h_B(s) = sum of G(k, k + s) over the block.
+  Eigen::MatrixXd h(nb, b), wb(nb, b);
+  for (long B = 0; B < nb; ++B)
+    for (long s = 0; s < b; ++s) {
+      double hs = 0, ws = 0;
+      for (long k = B * b; k + s < (B + 1) * b; ++k) hs += g(k, k + s), ws += w(k, k + s);
+      h(B, s) = hs;
+      wb(B, s) = (s == 0 ? 1.0 : 2.0) * ws / static_cast<double>(b - s);
+    }
+  const Eigen::RowVectorXd hbar = h.colwise().mean();
+  for (long B = 0; B < nb; ++B)
+    for (long C = 0; C < nb; ++C)
+      out.var_within += std::pow(wb.row(B).dot(h.row(C) - hbar), 2) / static_cast<double>(nb - 1);
+  out.err = std::sqrt(out.var_between + out.var_within);
+  return out;
+}
+
+PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt, long max_lag,
+                                            long block_frames, const Eigen::MatrixXd* mask) {
+  const long frames = static_cast<long>(v.rows());
+  if (frames < 2 || v.cols() < 1 || max_lag < 1 || max_lag >= frames || block_frames < 1 ||
+      !(dt > 0.0))
+    throw std::invalid_argument(fmt::format(
+        "persistence_with_errors: {} frames x {} particles, max_lag {}, block {} frames", frames,
+        v.cols(), max_lag, block_frames));
+  if (mask && (mask->rows() != v.rows() || mask->cols() != v.cols()))
+    throw std::invalid_argument("persistence_with_errors: mask shape differs from v");
+  PersistenceEstimate out;
+  const long nb = std::max(1L, frames / block_frames);
+  out.blocks = nb;
+  // Frames as contiguous columns: each (origin, lag) term is one dot product over particles.
+  const Eigen::MatrixXd vt = v.transpose();
+  Eigen::MatrixXd origin = vt;
+  if (mask) origin.array() *= mask->transpose().array();
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(nb, max_lag + 1), cnt = s;
+  for (long t0 = 0; t0 < frames; ++t0) {
+    const long B = std::min(nb - 1, t0 / block_frames);
+    const double weight = mask ? mask->row(t0).sum() : static_cast<double>(v.cols());
+    if (weight <= 0.0) continue;
+    const auto a = origin.col(t0);
+    for (long k = 0; k <= max_lag && t0 + k < frames; ++k) {
+      s(B, k) += a.dot(vt.col(t0 + k));
+      cnt(B, k) += weight;
+    }
+  }
+  const Eigen::RowVectorXd s_all = s.colwise().sum(), n_all = cnt.colwise().sum();
+  const auto correlation = [&](const Eigen::RowVectorXd& num, const Eigen::RowVectorXd& den) {
+    Autocorrelation c;
+    for (long k = 0; k <= max_lag; ++k) {
+      c.lag.push_back(static_cast<double>(k) * dt);
+      c.c.push_back(den(k) > 0 ? num(k) / den(k) : 0.0);
+    }
+    return c;
+  };
+  out.c = correlation(s_all, n_all);
+  out.p = persistence_time(out.c);
+  out.dv = std::sqrt(out.p.c0);
+  if (nb < 2) {
+    out.dv_err = out.psi_err = out.psi_e_err = out.psi_zero_err = out.psi_full_err = kNaN;
+    return out;
+  }
+  std::vector<double> dv, psi, psi_e, psi_zero, psi_full;
+  for (long B = 0; B < nb; ++B) {
+    const Autocorrelation c = correlation(s_all - s.row(B), n_all - cnt.row(B));
+    if (!(c.c[0] > 0.0)) {
+      dv.push_back(kNaN), psi.push_back(kNaN), psi_e.push_back(kNaN);
+      psi_zero.push_back(kNaN), psi_full.push_back(kNaN);
+      continue;
+    }
+    const Persistence p = persistence_time(c);
+    dv.push_back(std::sqrt(p.c0));
+    psi.push_back(p.psi), psi_e.push_back(p.psi_e), psi_zero.push_back(p.psi_zero);
+    psi_full.push_back(p.psi_full);
+  }
+  out.dv_err = jackknife_err(dv);
+  out.psi_err = jackknife_err(psi);
+  out.psi_e_err = jackknife_err(psi_e);
+  out.psi_zero_err = jackknife_err(psi_zero);
+  out.psi_full_err = jackknife_err(psi_full);
+  return out;
+}
+
+MsdResult masked_mean_square_displacement(const Eigen::MatrixXd& y, const Eigen::MatrixXd& mask,
+                                          double dt, long max_lag,
+                                          const std::vector<long>& reference_frames) {
+  const long frames = static_cast<long>(y.rows());
+  if (mask.rows() != y.rows() || mask.cols() != y.cols())
+    throw std::invalid_argument("masked_mean_square_displacement: mask shape differs from y");
+  if (max_lag < 1 || max_lag >= frames || reference_frames.empty())
+    throw std::invalid_argument(fmt::format(
+        "masked_mean_square_displacement: max_lag {} of {} frames, {} reference frames", max_lag,
+        frames, reference_frames.size()));
+  const Eigen::MatrixXd by_frame = y.transpose();
+  const Eigen::MatrixXd m = mask.transpose();
+  std::vector<double> acc(static_cast<std::size_t>(max_lag) + 1, 0.0);
+  double weight = 0;
+  for (long t0 : reference_frames) {
+    if (t0 < 0 || t0 + max_lag >= frames)
+      throw std::invalid_argument(fmt::format(
+          "masked_mean_square_displacement: reference frame {} with max_lag {} leaves [0, {})",
+          t0, max_lag, frames));
+    const auto base = by_frame.col(t0);
+    const auto w = m.col(t0);
+    weight += w.sum();
+    for (long k = 1; k <= max_lag; ++k)
+      acc[static_cast<std::size_t>(k)] +=
+          w.dot((by_frame.col(t0 + k) - base).cwiseAbs2());
+  }
+  MsdResult out;
+  for (long k = 0; k <= max_lag; ++k) {
+    out.lag.push_back(static_cast<double>(k) * dt);
+    out.msd.push_back(weight > 0 ? acc[static_cast<std::size_t>(k)] / weight : kNaN);
+    out.samples.push_back(static_cast<long>(weight));
+  }
+  return out;
+}
+
+}  // namespace sheardiff

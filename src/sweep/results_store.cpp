@@ -1,0 +1,66 @@
+// The persistent record of a sweep: each finished point's small results (no trajectories) in
+// spec.results/points/<name>/, so that a sweep spread over sessions, machines or a cluster is
+// continued and re-fitted from these files alone (docs/sweeps.md, "Results that persist").
+#include <fmt/format.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/sweep/sweep.hpp"
+
+namespace sheardiff {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_all(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("cannot read {}", file.string()));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+fs::path stored_point(const SweepSpec& spec, const SweepPoint& p) {
+  if (spec.results.empty()) return {};
+  const auto dir = spec.results / "points" / p.name;
+  if (!fs::exists(dir / "summary.json") || !fs::exists(dir / "config.toml")) return {};
+  // The same point only if its configuration is this point's (compared through the parser, as
+  // for run directories): a changed sweep never silently reuses old results.
+  std::string theirs;
+  try {
+    theirs = to_toml(load_config(dir / "config.toml"));
+  } catch (const ConfigError&) {
+    return {};
+  }
+  if (theirs != to_toml(load_config(spec.base, p.overrides)))
+    throw ConfigError(fmt::format(
+        "{} holds results of another configuration than sweep point {} (sweep file or base "
+        "config changed?); move them away or name another sweep.results",
+        dir.string(), p.name));
+  return dir;
+}
+
+bool export_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
+  if (spec.results.empty()) return false;
+  const auto src = point_dir(out_dir, p);
+  if (!fs::exists(src / "summary.json") || !fs::exists(src / "config.toml")) return false;
+  const auto dst = spec.results / "points" / p.name;
+  fs::create_directories(dst);
+  bool copied = false;
+  // config.toml first and summary.json last: a stored point counts once its summary is there.
+  for (const char* name : {"config.toml", "analysis.h5", "summary.json"}) {
+    if (!fs::exists(src / name)) continue;
+    const std::string bytes = read_all(src / name);
+    if (fs::exists(dst / name) && read_all(dst / name) == bytes) continue;
+    write_file_atomically(dst / name, bytes);
+    copied = true;
+  }
+  return copied;
+}
+
+}  // namespace sheardiff
