@@ -47,6 +47,10 @@ std::vector<std::string> PressureCellObserver::frame_names() const {
   return {"H", "phi", "mu_top", "mu_bottom", "pressure_measured", "wall_velocity_y"};
 }
 
+std::vector<std::string> PressureCellObserver::frame_units() const {
+  return {"d", "1", "1", "1", "P", "P d eta-1"};
+}
+
 void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& values) {
   const Dynamics& d = v.dynamics;
   const double a = d.box().lx * lz_;
@@ -175,7 +179,8 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
       t(b, 2) = ux;
       t(b, 3) = n > 0 ? prof_ux2_[b] / n - ux * ux + prof_uy2_[b] / n : 0.0;
     }
-    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, t);
+    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, {"d", "1", "P d eta-1", "P+2 d+2 eta-2"},
+                        t);
   }
 }
 
