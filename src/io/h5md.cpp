@@ -8,8 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -165,8 +165,8 @@ Handle enum_type(const std::vector<std::pair<const char*, std::int8_t>>& members
 
 template <class T>
 Handle write_fixed_dataset(hid_t loc, const std::string& full, hid_t file_type, hid_t mem_type,
-                           const std::vector<hsize_t>& dims, const T* data,
-                           const std::string& unit, const fs::path& file) {
+                           const std::vector<hsize_t>& dims, const T* data, const std::string& unit,
+                           const fs::path& file) {
   Handle space = simple_space(dims, nullptr, file, full);
   Handle ds = checked(
       H5Dcreate2(loc, full.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
@@ -202,16 +202,15 @@ struct Series {
     hsize_t n = 1;
     for (hsize_t c : count) n *= c;
     if (n > 0) {
-      Handle fspace =
-          checked(H5Dget_space(ds.get()), H5Sclose, file, name, "cannot get dataspace");
+      Handle fspace = checked(H5Dget_space(ds.get()), H5Sclose, file, name, "cannot get dataspace");
       std::vector<hsize_t> start(dims.size(), 0);
       start[0] = rows;
-      check(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr,
-                                count.data(), nullptr),
+      check(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                                nullptr),
             file, name, "cannot select row");
       Handle mspace = simple_space(count, nullptr, file, name);
-      check(H5Dwrite(ds.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), file,
-            name, "cannot write row");
+      check(H5Dwrite(ds.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), file, name,
+            "cannot write row");
     }
     ++rows;
   }
@@ -345,8 +344,8 @@ class Reader {
       fail(path_, group, "cannot list group");
     std::vector<std::string> out;
     for (hsize_t k = 0; k < info.nlinks; ++k) {
-      const ssize_t len = H5Lget_name_by_idx(file_.get(), group.c_str(), H5_INDEX_NAME,
-                                             H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
+      const ssize_t len = H5Lget_name_by_idx(file_.get(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC,
+                                             k, nullptr, 0, H5P_DEFAULT);
       if (len < 0) fail(path_, group, "cannot list group");
       std::string name(static_cast<std::size_t>(len) + 1, '\0');
       H5Lget_name_by_idx(file_.get(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k, name.data(),
@@ -551,8 +550,7 @@ constexpr const char* kContacts = "/connectivity/contacts";
 
 std::string author_name(const std::string& given) {
   if (!given.empty()) return given;
-  if (const char* env = std::getenv("SHEARDIFF_AUTHOR"); env != nullptr && *env != '\0')
-    return env;
+  if (const char* env = std::getenv("SHEARDIFF_AUTHOR"); env != nullptr && *env != '\0') return env;
   // The real name of the passwd entry (its first GECOS field), else the login.
   if (const passwd* pw = getpwuid(getuid()); pw != nullptr) {
     std::string gecos = pw->pw_gecos != nullptr ? pw->pw_gecos : "";
@@ -707,10 +705,9 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
 
   Handle obs_group = create_group(f, "/observables", path);
   for (std::size_t k = 0; k < layout.observables.size(); ++k) {
-    const std::string unit =
-        layout.observable_units.empty() ? kNumber : layout.observable_units[k];
-    m.observables.push_back(m.element("/observables/" + layout.observables[k], H5T_IEEE_F64LE,
-                                      {}, kScalarChunk, unit));
+    const std::string unit = layout.observable_units.empty() ? kNumber : layout.observable_units[k];
+    m.observables.push_back(
+        m.element("/observables/" + layout.observables[k], H5T_IEEE_F64LE, {}, kScalarChunk, unit));
   }
 
   if (layout.write_contacts) {
@@ -722,8 +719,8 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     {
       const std::string where = std::string(kContacts) + "@particles_group";
       Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, path, where, "dataspace");
-      Handle a = checked(H5Acreate2(contacts.get(), "particles_group", H5T_STD_REF_OBJ,
-                                    space.get(), H5P_DEFAULT, H5P_DEFAULT),
+      Handle a = checked(H5Acreate2(contacts.get(), "particles_group", H5T_STD_REF_OBJ, space.get(),
+                                    H5P_DEFAULT, H5P_DEFAULT),
                          H5Aclose, path, where, "cannot create attribute");
       check(H5Awrite(a.get(), H5T_STD_REF_OBJ, &ref), path, where, "cannot write attribute");
     }
@@ -762,8 +759,7 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   const hid_t f = m->file.get();
   const auto rows = static_cast<hsize_t>(keep_frames);
   const hsize_t n = layout.n_particles;
-  const auto value = [&](const std::string& full, std::vector<hsize_t> inner,
-                         bool ragged = false) {
+  const auto value = [&](const std::string& full, std::vector<hsize_t> inner, bool ragged = false) {
     return open_series(f, full, std::move(inner), rows, path, ragged);
   };
   // Hard links: cutting position's step and time cuts every element's.
@@ -919,14 +915,12 @@ void H5mdWriter::write_frame(const FrameData& frame) {
 }
 
 void H5mdWriter::write_table(const std::string& name, const std::vector<std::string>& columns,
-                             const std::vector<std::string>& units,
-                             const Eigen::MatrixXd& values) {
+                             const std::vector<std::string>& units, const Eigen::MatrixXd& values) {
   if (!impl_) throw std::logic_error("H5mdWriter: write_table on a moved-from writer");
   Impl& m = *impl_;
   check_name(name, m.path, "table");
   const std::string group_name = "/observables/" + name;
-  if (columns.size() != static_cast<std::size_t>(values.cols()) ||
-      units.size() != columns.size()) {
+  if (columns.size() != static_cast<std::size_t>(values.cols()) || units.size() != columns.size()) {
     fail(m.path, group_name,
          fmt::format("{} column names and {} units for {} columns", columns.size(), units.size(),
                      values.cols()));
@@ -995,7 +989,8 @@ H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
   H5mdFrame out;
   out.position = read_vectors(r, g + "/position/value", idx, std::nullopt);
   const hsize_t n = out.position.size();
-  out.step = static_cast<long>(axis_value<std::int64_t>(r, g + "/position/step", H5T_NATIVE_INT64, idx));
+  out.step =
+      static_cast<long>(axis_value<std::int64_t>(r, g + "/position/step", H5T_NATIVE_INT64, idx));
   if (r.exists(g + "/position/time"))
     out.time = axis_value<double>(r, g + "/position/time", H5T_NATIVE_DOUBLE, idx);
 

@@ -179,8 +179,8 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
       t(b, 2) = ux;
       t(b, 3) = n > 0 ? prof_ux2_[b] / n - ux * ux + prof_uy2_[b] / n : 0.0;
     }
-    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, {"d", "1", "P d eta-1", "P+2 d+2 eta-2"},
-                        t);
+    writer->write_table("profiles", {"y", "phi", "u_x", "T"},
+                        {"d", "1", "P d eta-1", "P+2 d+2 eta-2"}, t);
   }
 }
 

@@ -3,9 +3,9 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -361,8 +361,8 @@ TEST(H5md, BoxIsATriclinicMatrixAndStepTimeAreHardLinks) {
   H5Dclose(is);
   for (int k = 0; k < kFrames; ++k) {
     for (std::size_t i = 0; i < kN; ++i) {
-      const Vec2 r = pos(k, i) + image[k][i][0] * Vec2(6.0, 0.0) +
-                     image[k][i][1] * Vec2(reduced[k], ly_at(k));
+      const Vec2 r =
+          pos(k, i) + image[k][i][0] * Vec2(6.0, 0.0) + image[k][i][1] * Vec2(reduced[k], ly_at(k));
       EXPECT_LE(std::abs(r.y() - unw(k, i).y()), 0.5 * ly_at(k)) << k << " " << i;
       EXPECT_LE(std::abs(r.x() - unw(k, i).x()), 3.0) << k << " " << i;
     }
@@ -481,8 +481,8 @@ TEST(H5md, ContactNetworkRoundTripAndResume) {
   ASSERT_GE(f, 0);
   EXPECT_EQ(address(f, "/connectivity/contacts/step"), address(f, kG + "position/step"));
   hobj_ref_t ref{};
-  const hid_t a = H5Aopen_by_name(f, "/connectivity/contacts", "particles_group", H5P_DEFAULT,
-                                  H5P_DEFAULT);
+  const hid_t a =
+      H5Aopen_by_name(f, "/connectivity/contacts", "particles_group", H5P_DEFAULT, H5P_DEFAULT);
   ASSERT_GE(a, 0);
   ASSERT_GE(H5Aread(a, H5T_STD_REF_OBJ, &ref), 0);
   H5Aclose(a);
@@ -499,7 +499,9 @@ TEST(H5md, ContactNetworkRoundTripAndResume) {
 // triclinic box, fixed step/time storage, float32 positions, integer species.
 void write_foreign_file(const fs::path& file) {
   const hid_t f = H5Fcreate(file.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  const auto group = [&](const char* name) { H5Gclose(H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)); };
+  const auto group = [&](const char* name) {
+    H5Gclose(H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  };
   group("/h5md");
   group("/particles");
   group("/particles/all");
@@ -524,9 +526,9 @@ void write_foreign_file(const fs::path& file) {
   H5Gclose(box);
   const auto dataset = [&](const char* name, hid_t type, std::vector<hsize_t> dims,
                            const void* data, hid_t mem) {
-    const hid_t sp = dims.empty() ? H5Screate(H5S_SCALAR)
-                                  : H5Screate_simple(static_cast<int>(dims.size()), dims.data(),
-                                                     nullptr);
+    const hid_t sp = dims.empty()
+                         ? H5Screate(H5S_SCALAR)
+                         : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
     const hid_t ds = H5Dcreate2(f, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     H5Dwrite(ds, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
     H5Sclose(sp);
@@ -544,8 +546,8 @@ void write_foreign_file(const fs::path& file) {
   const double dt = 0.5;
   H5Dclose(dataset("/particles/all/position/time", H5T_IEEE_F64LE, {}, &dt, H5T_NATIVE_DOUBLE));
   const float xyz[2][2][3] = {{{1, 2, 0}, {3, 1, 0}}, {{1.5f, 2.5f, 0}, {3.5f, 0.5f, 0}}};
-  H5Dclose(dataset("/particles/all/position/value", H5T_IEEE_F32LE, {2, 2, 3}, xyz,
-                   H5T_NATIVE_FLOAT));
+  H5Dclose(
+      dataset("/particles/all/position/value", H5T_IEEE_F32LE, {2, 2, 3}, xyz, H5T_NATIVE_FLOAT));
   const int species[2] = {0, 1};
   H5Dclose(dataset("/particles/all/species", H5T_STD_I32LE, {2}, species, H5T_NATIVE_INT));
   H5Sclose(scalar);

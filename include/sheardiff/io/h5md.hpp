@@ -91,8 +91,8 @@ struct H5mdFrame {
   long step = 0;
   double time = 0;
   double lx = 0, ly = 0;
-  double tilt = 0;          // x component of the second edge vector (0 for a cuboid box)
-  bool periodic_y = true;   // box/boundary[1]; ly is a placeholder where it is "none"
+  double tilt = 0;         // x component of the second edge vector (0 for a cuboid box)
+  bool periodic_y = true;  // box/boundary[1]; ly is a placeholder where it is "none"
   std::vector<Vec2> position;
   std::vector<Vec2> unwrapped;  // empty if the file has no unwrapped_position
   std::vector<Vec3> velocity;   // empty if the file has no velocity
