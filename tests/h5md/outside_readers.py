@@ -168,6 +168,22 @@ def check_gsd(root, traj, periodic_y):
         expect(false_pairs > 0, f"{name}: the box without its tilt shows false overlaps (the check has teeth)")
 
 
+def check_plot_tools(root, work, runs):
+    """The plot tools draw both runs (no analysis.h5 in either) and end with one line, not a
+    traceback, when their input is missing."""
+    for tool, png in (("plot_run.py", "timeseries.png"), ("snapshot.py", "snapshot.png")):
+        for run_dir in runs:
+            p = subprocess.run([sys.executable, str(root / "tools" / tool), str(run_dir)],
+                               capture_output=True, text=True)
+            expect(p.returncode == 0 and (run_dir / png).is_file(),
+                   f"{tool} draws {run_dir.name}/{png}" + (f": {p.stderr.strip()}" if p.returncode else ""))
+        p = subprocess.run([sys.executable, str(root / "tools" / tool), str(work / "missing")],
+                           capture_output=True, text=True)
+        lines = p.stderr.strip().splitlines()
+        expect(p.returncode != 0 and len(lines) == 1 and "Traceback" not in p.stderr,
+               f"{tool} on a missing run: one line ({lines[:1]})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -194,6 +210,7 @@ def main():
     else:
         check_gsd(args.root, simple, True)
         check_gsd(args.root, pressure, False)
+    check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
     print(f"{len(failures)} failed")
     sys.exit(1 if failures else 0)
 
