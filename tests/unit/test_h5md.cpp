@@ -576,6 +576,57 @@ TEST(H5md, ReadsAnotherWritersFileQuietly) {
   EXPECT_TRUE(read_h5md_contacts(file).pairs.empty());
 }
 
+// The layout before issue 17: a cuboid box vector per frame with its own step and time.
+TEST(H5md, ReadsTheOldCuboidLayout) {
+  TempDir dir;
+  const fs::path file = dir.path() / "old.h5";
+  const hid_t f = H5Fcreate(file.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  for (const char* g : {"/particles", "/particles/suspension", "/particles/suspension/box",
+                        "/particles/suspension/box/edges", "/particles/suspension/position"})
+    H5Gclose(H5Gcreate2(f, g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  const hid_t box = H5Gopen2(f, "/particles/suspension/box", H5P_DEFAULT);
+  const hid_t vl = H5Tcopy(H5T_C_S1);
+  H5Tset_size(vl, H5T_VARIABLE);
+  H5Tset_cset(vl, H5T_CSET_UTF8);
+  const hsize_t two[1] = {2};
+  const hid_t s2 = H5Screate_simple(1, two, nullptr);
+  const char* bnd[2] = {"periodic", "periodic"};
+  const hid_t a = H5Acreate2(box, "boundary", vl, s2, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, vl, bnd);
+  H5Aclose(a);
+  H5Sclose(s2);
+  H5Tclose(vl);
+  H5Gclose(box);
+  const auto dataset = [&](const char* name, hid_t type, std::vector<hsize_t> dims,
+                           const void* data, hid_t mem) {
+    const hid_t sp = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    H5Dclose(H5Dcreate2(f, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    const hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    H5Dwrite(ds, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Dclose(ds);
+    H5Sclose(sp);
+  };
+  const std::int64_t step[1] = {40};
+  const double time[1] = {2.0}, edges[1][2] = {{6.0, 7.0}}, xy[1][1][2] = {{{1.0, 2.0}}};
+  const int motion[1] = {0};
+  for (const char* e : {"box/edges", "position"}) {
+    dataset((kG + e + "/step").c_str(), H5T_STD_I64LE, {1}, step, H5T_NATIVE_INT64);
+    dataset((kG + e + "/time").c_str(), H5T_IEEE_F64LE, {1}, time, H5T_NATIVE_DOUBLE);
+  }
+  dataset((kG + "box/edges/value").c_str(), H5T_IEEE_F64LE, {1, 2}, edges, H5T_NATIVE_DOUBLE);
+  dataset((kG + "position/value").c_str(), H5T_IEEE_F64LE, {1, 1, 2}, xy, H5T_NATIVE_DOUBLE);
+  dataset((kG + "motion").c_str(), H5T_STD_I32LE, {1}, motion, H5T_NATIVE_INT);
+  H5Fclose(f);
+
+  const H5mdFrame fr = read_h5md_frame(file);
+  EXPECT_EQ(fr.step, 40);
+  EXPECT_EQ(fr.lx, 6.0);
+  EXPECT_EQ(fr.ly, 7.0);
+  EXPECT_EQ(fr.tilt, 0.0);
+  EXPECT_EQ(fr.position[0], Vec2(1.0, 2.0));
+  EXPECT_EQ(fr.motion, (std::vector<int>{0}));
+}
+
 TEST(PositionTable, ReadsWithCommentsAndBlankLines) {
   TempDir dir;
   const fs::path file = dir.path() / "pos.txt";
