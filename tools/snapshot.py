@@ -54,7 +54,9 @@ def title_of(run_dir, fr):
     summary = json.loads(summ_file.read_text()) if summ_file.is_file() else {}
     j = cfg.get("flow", {}).get("J", summary.get("J"))
     mobile = fr["motion"] == 0
-    if "phi" in fr["obs"]:  # pressure cell: the bulk area fraction of this frame
+    if "phi" in summary:  # the run's: fixed, or the steady mean of a pressure cell
+        phi = summary["phi"]
+    elif "phi" in fr["obs"]:  # an unfinished pressure cell: the bulk area fraction of this frame
         phi = fr["obs"]["phi"]
     else:
         phi = np.sum(np.pi * fr["diam"][mobile] ** 2 / 4) / (fr["lx"] * fr["ly"])
