@@ -265,6 +265,13 @@ const std::vector<KeySpec>& schema() {
                      "a frame); 0 = only on SIGINT/SIGTERM. Resume with --resume DIR."));
     s.push_back(boolean("output.trajectory", &C::output, &C::Output::trajectory,
                         "Write DIR/trajectory.h5 (summary.json is always written)."));
+    s.push_back(boolean("output.contacts", &C::output, &C::Output::contacts,
+                        "Write the contact network of every frame to /connectivity/contacts of "
+                        "the trajectory: pairs, normal and tangential force, sliding flag "
+                        "(docs/trajectory.md)."));
+    s.push_back(text("output.author", &C::output, &C::Output::author,
+                     "Author's name in the trajectory (/h5md/author); empty: the environment "
+                     "variable SHEARDIFF_AUTHOR, else the account's name."));
     s.push_back(real("health.max_overlap", &C::health, &C::Health::max_overlap, 0.0, 1.0, true, "d",
                      "Run health: stop the run (exit 4) when a contact overlaps by more. The "
                      "mean overlap is ~1/ktilde d, so 0.1 d is 10x it at ktilde = 1e2 and 1000x "

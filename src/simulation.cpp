@@ -19,6 +19,7 @@
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/run_health.hpp"
+#include "sheardiff/observe/stress.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
 namespace sheardiff {
@@ -226,9 +227,11 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     serialize(a);
   }
 
-  std::vector<std::string> names;
-  for (const auto& o : observers)
+  std::vector<std::string> names, units;
+  for (const auto& o : observers) {
     for (auto& n : o->frame_names()) names.push_back(n);
+    for (auto& u : o->frame_units()) units.push_back(u);
+  }
   std::unique_ptr<H5mdWriter> writer;
   if (cfg.output.trajectory) {
     TrajectoryLayout layout;
@@ -241,6 +244,9 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     layout.lees_edwards = d.box().lees_edwards;
     layout.write_velocity = cfg.output.velocities;
     layout.observables = names;
+    layout.observable_units = units;
+    layout.write_contacts = cfg.output.contacts;
+    layout.author = cfg.output.author;
     layout.creator_version = SHEARDIFF_VERSION;
     layout.config_toml = resolved;
     const auto file = out_dir / "trajectory.h5";
@@ -307,10 +313,14 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
         f.time = d.time();
         f.lx = d.box().lx;
         f.ly = d.height();
+        f.tilt = d.box().le_offset;
         f.position = &p.position;
         f.unwrapped = &p.unwrapped;
         f.velocity = &sim.integrator().velocities().u;
         f.observables = values;
+        ContactNetwork contacts;
+        if (cfg.output.contacts) contacts = contact_network(d);
+        f.contacts = &contacts;
         writer->write_frame(f);
       }
       ++frames;

@@ -1,29 +1,109 @@
 #!/usr/bin/python3
-"""Plot the diffusion analysis of one run: MSD in the gradient direction against strain (with
-the fit window and the fitted line 2 D t + c) and the velocity autocorrelation C(tau)/C(0) (with
-the persistence time Psi), from RUN/analysis.h5 and RUN/summary.json.
+"""Plot one run: time series against strain from RUN/trajectory.h5 (any run, finished or not)
+and, where RUN/analysis.h5 exists, the diffusion analysis.
 
-    /usr/bin/python3 tools/plot_run.py RUN_DIR [--out RUN_DIR/analysis.png]
+    /usr/bin/python3 tools/plot_run.py RUN_DIR [--out RUN_DIR/timeseries.png]
+
+timeseries.png: the friction coefficient mu, the area fraction phi, the gap H and the pressure
+on the top wall (pressure cell; a simple-shear run has the particle pressure and no H) against
+strain, with the steady window shaded (pressure cell: from summary.json's steady_strain, the
+measurement starting at steady_detected_at; simple shear: after run.transient_strain) and the
+window's mean +- standard error in each panel.
+analysis.png (only with analysis.h5): the MSD in the gradient direction with the fit window and
+the line 2 D t + c, and the velocity autocorrelation C(tau)/C(0) with the persistence time Psi.
 """
 import argparse
 import json
 import pathlib
+import sys
+import tomllib
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from scipy import ndimage, stats  # noqa: E402
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("run", type=pathlib.Path)
-    ap.add_argument("--out", type=pathlib.Path)
-    args = ap.parse_args()
-    summary = json.loads((args.run / "summary.json").read_text())
-    with h5py.File(args.run / "analysis.h5", "r") as f:
+def load_series(traj):
+    import h5py
+
+    with h5py.File(traj, "r") as f:
+        obs = f["observables"]
+        return {k: obs[k]["value"][()] for k in obs if "value" in obs[k]}
+
+
+def panels(series, pressure_cell, phi_fixed):
+    """(label, values) for the panels this run has."""
+    out = []
+    if pressure_cell:
+        out.append((r"$\mu$", 0.5 * (series["mu_top"] + series["mu_bottom"])))
+        out.append((r"$\phi$", series["phi"]))
+        out.append((r"$H / d$", series["H"]))
+        out.append((r"wall pressure / $P$", series["pressure_measured"]))
+    else:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out.append((r"$\mu = \sigma_{xy} / \Pi$", series["shear_stress"] / series["pressure"]))
+        if phi_fixed is not None:
+            out.append((r"$\phi$ (fixed)", np.full_like(series["strain"], phi_fixed)))
+        out.append((r"particle pressure $\Pi / P$", series["pressure"]))
+    return out
+
+
+def plot_timeseries(run, out):
+    traj = run / "trajectory.h5"
+    cfg = tomllib.loads((run / "config.toml").read_text()) if (run / "config.toml").is_file() else {}
+    summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").is_file() else {}
+    series = load_series(traj)
+    if "strain" not in series or len(series["strain"]) == 0:
+        sys.exit(f"plot_run: {traj} holds no frames yet")
+    strain = series["strain"]
+    pressure_cell = "mu_top" in series
+    window, detected = None, None
+    if pressure_cell and summary.get("steady"):
+        window, detected = (summary["steady_strain"], strain[-1]), summary.get("steady_detected_at")
+    elif not pressure_cell:
+        window = (cfg.get("run", {}).get("transient_strain", 0.0), strain[-1])
+    rows = panels(series, pressure_cell, summary.get("phi"))
+    fig, axes = plt.subplots(len(rows), 1, figsize=(7, 2.1 * len(rows)), sharex=True)
+    # A running mean over about one strain shows the drift through the fluctuations.
+    width = max(1, int(round(1.0 / max(np.median(np.diff(strain)), 1e-12)))) if len(strain) > 1 else 1
+    for ax, (label, y) in zip(np.atleast_1d(axes), rows):
+        ax.plot(strain, y, "-", color="0.55", lw=0.8)
+        if width > 1 and len(y) > width:
+            ax.plot(strain, ndimage.uniform_filter1d(y, width, mode="nearest"), "-", color="C0", lw=1.5)
+        if window is not None:
+            ax.axvspan(*window, color="C2", alpha=0.12, lw=0)
+            sel = (strain >= window[0]) & np.isfinite(y)
+            if sel.sum() >= 2:
+                m, e = np.mean(y[sel]), stats.sem(y[sel])
+                ax.axhline(m, color="C2", lw=1, ls="--", label=f"steady: {m:.4g} $\\pm$ {e:.2g}")
+                ax.legend(loc="best", fontsize=8, frameon=False)
+        if detected is not None:
+            ax.axvline(detected, color="C2", lw=0.8, ls=":")
+        ax.set_ylabel(label)
+        ax.ticklabel_format(axis="y", useOffset=False)
+        finite = y[np.isfinite(y)]
+        if finite.size and np.ptp(finite) <= 1e-6 * max(abs(finite.mean()), 1e-12):
+            ax.set_ylim(finite.mean() * 0.99, finite.mean() * 1.01)  # held to round-off
+    np.atleast_1d(axes)[-1].set_xlabel(r"strain $\dot\gamma t$")
+    scene = "pressure cell" if pressure_cell else "simple shear"
+    title = f"{run.name}: {scene}, J = {cfg.get('flow', {}).get('J', float('nan')):g}, N = {cfg.get('particles', {}).get('N', '?')}"
+    if pressure_cell and not summary.get("steady"):
+        title += " (no steady state" + (" yet)" if not summary else ")")
+    np.atleast_1d(axes)[0].set_title(title)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    print(out)
+
+
+def plot_analysis(run, out):
+    import h5py
+
+    summary = json.loads((run / "summary.json").read_text())
+    with h5py.File(run / "analysis.h5", "r") as f:
         lag, msd = f["msd/lag"][()], f["msd/msd"][()]
         tau, c = f["vacf/lag"][()], f["vacf/c"][()]
         d, intercept = f.attrs["D"], f.attrs["msd_intercept"]
@@ -49,9 +129,24 @@ def main():
     ax2.set_title(f"dv = {summary['dv']:.3g} $\\dot\\gamma d$")
     ax2.legend()
     fig.tight_layout()
-    out = args.out or args.run / "analysis.png"
     fig.savefig(out, dpi=110)
+    plt.close(fig)
     print(out)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("run", type=pathlib.Path)
+    ap.add_argument("--out", type=pathlib.Path, help="time-series PNG (default RUN/timeseries.png)")
+    args = ap.parse_args()
+    if not (args.run / "trajectory.h5").is_file():
+        sys.exit(f"plot_run: no trajectory at {args.run / 'trajectory.h5'} (run with output.trajectory = true)")
+    try:
+        plot_timeseries(args.run, args.out or args.run / "timeseries.png")
+        if (args.run / "analysis.h5").is_file() and (args.run / "summary.json").is_file():
+            plot_analysis(args.run, args.run / "analysis.png")
+    except (OSError, KeyError) as e:
+        sys.exit(f"plot_run: {args.run}: cannot read the run ({type(e).__name__}: {e})")
 
 
 if __name__ == "__main__":

@@ -10,7 +10,8 @@ PKGS=(build-essential cmake ninja-build pkg-config
       libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
       libsuitesparse-dev libopenblas0-pthread
       clang-14 libclang-rt-14-dev  # libFuzzer for the ctest fuzz_config_smoke (tests/fuzz/)
-      python3 python3-numpy python3-scipy python3-matplotlib python3-h5py)
+      python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
+      python3-gsd)  # the GSD export (tools/h5md_to_gsd.py) and its ctest h5md_outside_readers
 
 missing=()
 for p in "${PKGS[@]}"; do

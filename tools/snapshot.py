@@ -2,14 +2,18 @@
 """Render one frame of a sheardiff H5MD trajectory to PNG.
 
 Walls are black; mobile particles are coloured by their height at the first frame (as in the
-seed paper's figure 1a-b), so mixing across the gap shows as mixed colours.
+seed paper's figure 1a-b, with a colour bar), so mixing across the gap shows as mixed colours.
+Discs crossing a periodic edge are drawn on both sides: across x, and across the Lees-Edwards
+y edges shifted by the frame's tilt (box/edges). The title gives the run's J, phi and N.
 
     /usr/bin/python3 tools/snapshot.py RUN_DIR [--frame -1] [--out RUN_DIR/snapshot.png]
 """
 import argparse
+import json
 import pathlib
+import sys
+import tomllib
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -19,6 +23,49 @@ from matplotlib.patches import Circle  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+def read_frame(path, frame):
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        groups = list(f["particles"])
+        g = f["particles"]["suspension" if "suspension" in groups else groups[0]]
+        pos = g["position/value"]
+        n_frames = pos.shape[0]
+        if n_frames == 0:
+            sys.exit(f"snapshot: {path} holds no frames yet")
+        k = frame % n_frames
+        edges = g["box/edges/value"][k]
+        if edges.ndim == 1:  # a cuboid box (files before the triclinic layout)
+            edges = np.diag(edges)
+        boundary = [b.decode() if isinstance(b, bytes) else str(b) for b in g["box"].attrs["boundary"]]
+        obs = f.get("observables", {})
+        frame_obs = {name: obs[name]["value"][k] for name in ("strain", "phi")
+                     if name in obs and "value" in obs[name]}
+        diam = g["diameter"][()]
+        return dict(k=k, x=pos[k], x0=pos[0], diam=diam,
+                    motion=g["motion"][()] if "motion" in g else np.zeros(len(diam), int),
+                    lx=edges[0, 0], tilt=edges[1, 0], ly=edges[1, 1],
+                    periodic_y=boundary[1] == "periodic", obs=frame_obs)
+
+
+def title_of(run_dir, fr):
+    cfg_file, summ_file = run_dir / "config.toml", run_dir / "summary.json"
+    cfg = tomllib.loads(cfg_file.read_text()) if cfg_file.is_file() else {}
+    summary = json.loads(summ_file.read_text()) if summ_file.is_file() else {}
+    j = cfg.get("flow", {}).get("J", summary.get("J"))
+    mobile = fr["motion"] == 0
+    if "phi" in summary:  # the run's: fixed, or the steady mean of a pressure cell
+        phi = summary["phi"]
+    elif "phi" in fr["obs"]:  # an unfinished pressure cell: the bulk area fraction of this frame
+        phi = fr["obs"]["phi"]
+    else:
+        phi = np.sum(np.pi * fr["diam"][mobile] ** 2 / 4) / (fr["lx"] * fr["ly"])
+    strain = fr["obs"].get("strain", float("nan"))
+    j_text = f"J = {j:g}, " if j is not None else ""
+    return (f"{run_dir.name}: {j_text}$\\phi$ = {phi:.3f}, N = {int(mobile.sum())}\n"
+            f"frame {fr['k']}, strain {strain:.3g}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("run", type=pathlib.Path, help="run directory (holds trajectory.h5) or an .h5 file")
@@ -26,40 +73,51 @@ def main():
     ap.add_argument("--out", type=pathlib.Path, help="PNG file (default: RUN/snapshot.png)")
     args = ap.parse_args()
     path = args.run / "trajectory.h5" if args.run.is_dir() else args.run
+    if not path.is_file():
+        sys.exit(f"snapshot: no trajectory at {path}")
     out = args.out or path.parent / "snapshot.png"
-    with h5py.File(path, "r") as f:
-        g = f["particles/suspension"]
-        pos = g["position/value"]
-        n_frames = pos.shape[0]
-        if n_frames == 0:
-            raise SystemExit(f"{path}: no frames")
-        k = args.frame % n_frames
-        x = pos[k]
-        x0 = pos[0]
-        diam = g["diameter"][()]
-        motion = g["motion"][()] if "motion" in g else np.zeros(len(diam), int)
-        lx, ly = g["box/edges/value"][k]
-        strain = f["observables/strain/value"][k] if "observables/strain" in f else float("nan")
-    mobile = motion == 0
+    try:
+        fr = read_frame(path, args.frame)
+    except (OSError, KeyError) as e:
+        sys.exit(f"snapshot: {path}: not a readable sheardiff trajectory ({type(e).__name__}: {e})")
+    x, x0, diam, lx, ly, tilt = fr["x"].copy(), fr["x0"], fr["diam"], fr["lx"], fr["ly"], fr["tilt"]
+    mobile = fr["motion"] == 0
+    if fr["periodic_y"]:  # into the primary cell [0, lx) x [0, ly), through the sheared edge
+        ny = np.floor(x[:, 1] / ly)
+        x[:, 1] -= ny * ly
+        x[:, 0] -= ny * tilt
+    x[:, 0] %= lx
     colour_key = x0[:, 1]
     lo, hi = colour_key[mobile].min(), colour_key[mobile].max()
     cmap = plt.get_cmap("coolwarm")
-    fig, ax = plt.subplots(figsize=(6, 6 * max(0.3, (x[:, 1].max() - x[:, 1].min() + 2) / lx)))
+    norm = matplotlib.colors.Normalize(vmin=lo, vmax=max(hi, lo + 1e-12))
+    ylo, yhi = (0.0, ly) if fr["periodic_y"] else (x[:, 1].min() - 1, x[:, 1].max() + 1)
+    fig, ax = plt.subplots(figsize=(6.8, 6 * max(0.3, (yhi - ylo) / lx)))
+    y_images = (-1, 0, 1) if fr["periodic_y"] else (0,)
     patches, colours = [], []
     for i in range(len(diam)):
-        for shift in (-lx, 0.0, lx):  # periodic in x: draw the images that cross the edges
-            cx = x[i, 0] % lx + shift
-            if cx + diam[i] / 2 < 0 or cx - diam[i] / 2 > lx:
+        a = diam[i] / 2
+        colour = "black" if not mobile[i] else cmap(norm(colour_key[i]))
+        for ky in y_images:
+            cy = x[i, 1] + ky * ly
+            if fr["periodic_y"] and (cy + a < 0 or cy - a > ly):
                 continue
-            patches.append(Circle((cx, x[i, 1]), diam[i] / 2))
-            colours.append("black" if not mobile[i] else cmap((colour_key[i] - lo) / max(hi - lo, 1e-12)))
+            base = (x[i, 0] + ky * tilt) % lx  # the image across a y edge is shifted by the tilt
+            for kx in (-1, 0, 1):
+                cx = base + kx * lx
+                if cx + a < 0 or cx - a > lx:
+                    continue
+                patches.append(Circle((cx, cy), a))
+                colours.append(colour)
     ax.add_collection(PatchCollection(patches, facecolors=colours, edgecolors="none"))
     ax.set_xlim(0, lx)
-    ax.set_ylim(x[:, 1].min() - 1, x[:, 1].max() + 1)
+    ax.set_ylim(ylo, yhi)
     ax.set_aspect("equal")
     ax.set_xlabel("x / d")
     ax.set_ylabel("y / d")
-    ax.set_title(f"{path.parent.name}: frame {k}, strain {strain:.3g}")
+    ax.set_title(title_of(path.parent, fr), fontsize=10)
+    bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8)
+    bar.set_label("height at the first frame, y / d")
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     print(out)

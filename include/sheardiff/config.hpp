@@ -90,6 +90,8 @@ struct Config {
     bool velocities = true;
     bool trajectory = true;
     double checkpoint_strain = 1.0;  // 0 = no periodic checkpoints
+    bool contacts = false;           // the contact network of every frame in the trajectory
+    std::string author;              // /h5md/author; empty: $SHEARDIFF_AUTHOR, else the account
   } output;
   struct Health {
     double max_overlap = 0.1;    // d: a run with a larger contact overlap is stopped

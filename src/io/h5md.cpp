@@ -3,9 +3,14 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <hdf5.h>
+#include <pwd.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
@@ -97,27 +102,44 @@ Handle create_group(hid_t loc, const std::string& full, const fs::path& file) {
                  file, full, "cannot create group");
 }
 
-Handle string_type(const fs::path& file, std::string_view object) {
-  Handle t = checked(H5Tcopy(H5T_C_S1), H5Tclose, file, object, "cannot create string type");
-  check(H5Tset_size(t.get(), H5T_VARIABLE), file, object, "cannot create string type");
-  check(H5Tset_cset(t.get(), H5T_CSET_UTF8), file, object, "cannot create string type");
-  return t;
-}
-
 // Variable-length strings keep large values (the config text) out of the 64 kB object header.
+// H5MD 1.1 asks for fixed-length strings in /h5md and box/boundary, and the units module for
+// variable-length ASCII in `unit`.
+enum class Str { VlUtf8, VlAscii, Fixed };
+
 void write_string_attr(hid_t obj, const std::string& obj_name, const char* attr,
-                       const std::vector<std::string>& values, bool scalar, const fs::path& file) {
+                       const std::vector<std::string>& values, bool scalar, const fs::path& file,
+                       Str kind = Str::VlUtf8) {
   const std::string where = obj_name + "@" + attr;
-  Handle type = string_type(file, where);
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, file, where, "cannot create string type");
+  std::size_t longest = 1;
+  for (const auto& v : values) longest = std::max(longest, v.size() + 1);
+  check(H5Tset_size(type.get(), kind == Str::Fixed ? longest : H5T_VARIABLE), file, where,
+        "cannot create string type");
+  if (kind == Str::Fixed) check(H5Tset_strpad(type.get(), H5T_STR_NULLTERM), file, where, "pad");
+  check(H5Tset_cset(type.get(), kind == Str::VlUtf8 ? H5T_CSET_UTF8 : H5T_CSET_ASCII), file, where,
+        "cannot create string type");
   Handle space =
       scalar ? checked(H5Screate(H5S_SCALAR), H5Sclose, file, where, "cannot create dataspace")
              : simple_space({values.size()}, nullptr, file, where);
   Handle a = checked(H5Acreate2(obj, attr, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
                      H5Aclose, file, where, "cannot create attribute");
+  if (kind == Str::Fixed) {
+    std::vector<char> buf(longest * values.size(), '\0');
+    for (std::size_t k = 0; k < values.size(); ++k)
+      std::copy(values[k].begin(), values[k].end(), buf.begin() + k * longest);
+    check(H5Awrite(a.get(), type.get(), buf.data()), file, where, "cannot write attribute");
+    return;
+  }
   std::vector<const char*> ptrs;
   ptrs.reserve(values.size());
   for (const auto& v : values) ptrs.push_back(v.c_str());
   check(H5Awrite(a.get(), type.get(), ptrs.data()), file, where, "cannot write attribute");
+}
+
+void write_unit(hid_t obj, const std::string& obj_name, const std::string& unit,
+                const fs::path& file) {
+  write_string_attr(obj, obj_name, "unit", {unit}, true, file, Str::VlAscii);
 }
 
 void write_int_attr(hid_t obj, const std::string& obj_name, const char* attr,
@@ -131,9 +153,20 @@ void write_int_attr(hid_t obj, const std::string& obj_name, const char* attr,
   check(H5Awrite(a.get(), H5T_NATIVE_INT, values.data()), file, where, "cannot write attribute");
 }
 
+// An HDF5 enumeration names its codes in the file itself (H5MD allows Enumeration for species).
+Handle enum_type(const std::vector<std::pair<const char*, std::int8_t>>& members,
+                 const fs::path& file, std::string_view object) {
+  Handle t = checked(H5Tenum_create(H5T_STD_I8LE), H5Tclose, file, object,
+                     "cannot create enumeration type");
+  for (const auto& [name, value] : members)
+    check(H5Tenum_insert(t.get(), name, &value), file, object, "cannot create enumeration type");
+  return t;
+}
+
 template <class T>
-void write_fixed_dataset(hid_t loc, const std::string& full, hid_t file_type, hid_t mem_type,
-                         const std::vector<hsize_t>& dims, const T* data, const fs::path& file) {
+Handle write_fixed_dataset(hid_t loc, const std::string& full, hid_t file_type, hid_t mem_type,
+                           const std::vector<hsize_t>& dims, const T* data, const std::string& unit,
+                           const fs::path& file) {
   Handle space = simple_space(dims, nullptr, file, full);
   Handle ds = checked(
       H5Dcreate2(loc, full.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
@@ -144,99 +177,108 @@ void write_fixed_dataset(hid_t loc, const std::string& full, hid_t file_type, hi
     check(H5Dwrite(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), file, full,
           "cannot write dataset");
   }
+  write_unit(ds.get(), full, unit, file);
+  return ds;
 }
 
-// A dataset growing by one row per frame along an unlimited first dimension.
+// A dataset growing by one row per frame along an unlimited first dimension. A ragged series
+// (the contacts) also grows along its second dimension; entries past a row's length keep the
+// dataset's fill value.
 struct Series {
   Handle ds;
   std::string name;
   std::vector<hsize_t> inner;  // shape of one row
   hsize_t rows = 0;
+  bool ragged = false;
 
-  void append(hid_t mem_type, const void* data, const fs::path& file) {
+  void append(hid_t mem_type, const void* data, const fs::path& file, hsize_t length = 0) {
     std::vector<hsize_t> dims{rows + 1};
+    if (ragged) inner[0] = std::max(inner[0], length);
     dims.insert(dims.end(), inner.begin(), inner.end());
     check(H5Dset_extent(ds.get(), dims.data()), file, name, "cannot extend dataset");
-    Handle fspace = checked(H5Dget_space(ds.get()), H5Sclose, file, name, "cannot get dataspace");
-    std::vector<hsize_t> start(dims.size(), 0);
-    start[0] = rows;
     std::vector<hsize_t> count = dims;
     count[0] = 1;
-    check(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                              nullptr),
-          file, name, "cannot select row");
-    Handle mspace = simple_space(count, nullptr, file, name);
-    check(H5Dwrite(ds.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), file, name,
-          "cannot write row");
+    if (ragged) count[1] = length;
+    hsize_t n = 1;
+    for (hsize_t c : count) n *= c;
+    if (n > 0) {
+      Handle fspace = checked(H5Dget_space(ds.get()), H5Sclose, file, name, "cannot get dataspace");
+      std::vector<hsize_t> start(dims.size(), 0);
+      start[0] = rows;
+      check(H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                                nullptr),
+            file, name, "cannot select row");
+      Handle mspace = simple_space(count, nullptr, file, name);
+      check(H5Dwrite(ds.get(), mem_type, mspace.get(), fspace.get(), H5P_DEFAULT, data), file, name,
+            "cannot write row");
+    }
     ++rows;
   }
 };
 
 Series create_series(hid_t loc, const std::string& full, hid_t file_type,
-                     std::vector<hsize_t> inner, hsize_t chunk_rows, const fs::path& file) {
+                     std::vector<hsize_t> inner, hsize_t chunk_rows, const fs::path& file,
+                     const void* fill = nullptr) {
+  const bool ragged = fill != nullptr;  // only the contact datasets are ragged, and have a fill
   std::vector<hsize_t> dims{0};
   dims.insert(dims.end(), inner.begin(), inner.end());
   std::vector<hsize_t> maxdims = dims;
   maxdims[0] = H5S_UNLIMITED;
   std::vector<hsize_t> chunk = dims;
   chunk[0] = chunk_rows;
+  if (ragged) {
+    maxdims[1] = H5S_UNLIMITED;
+    chunk[1] = 512;
+  }
   Handle space = simple_space(dims, &maxdims, file, full);
   Handle dcpl =
       checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, file, full, "cannot create property list");
   check(H5Pset_chunk(dcpl.get(), static_cast<int>(chunk.size()), chunk.data()), file, full,
         "cannot set chunking");
+  if (fill != nullptr)
+    check(H5Pset_fill_value(dcpl.get(), file_type, fill), file, full, "cannot set fill value");
   Series s;
   s.ds = checked(
       H5Dcreate2(loc, full.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
       H5Dclose, file, full, "cannot create dataset");
   s.name = full;
   s.inner = std::move(inner);
+  s.ragged = ragged;
   return s;
 }
 
-// Opens an existing series and cuts it back to `rows` rows.
+// Opens an existing series, checks its row shape and cuts it back to `rows` rows.
 Series open_series(hid_t loc, const std::string& full, std::vector<hsize_t> inner, hsize_t rows,
-                   const fs::path& file) {
+                   const fs::path& file, bool ragged = false) {
   Series s;
   s.ds = checked(H5Dopen2(loc, full.c_str(), H5P_DEFAULT), H5Dclose, file, full,
                  "cannot open dataset");
   s.name = full;
-  s.inner = std::move(inner);
+  s.ragged = ragged;
   Handle space = checked(H5Dget_space(s.ds.get()), H5Sclose, file, full, "cannot get dataspace");
-  hsize_t have = 0;
-  if (H5Sget_simple_extent_ndims(space.get()) < 1) fail(file, full, "expected rank >= 1");
-  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space.get())));
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank < 1) fail(file, full, "expected rank >= 1");
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
   H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
-  have = dims[0];
-  if (have < rows)
-    fail(file, full, fmt::format("holds {} rows, the checkpoint needs {}", have, rows));
+  std::vector<hsize_t> have_inner(dims.begin() + 1, dims.end());
+  if (ragged && !have_inner.empty() && !inner.empty()) inner[0] = have_inner[0];
+  if (have_inner != inner)
+    fail(file, full,
+         fmt::format("row shape ({}) differs from this version's ({}): the trajectory was "
+                     "written by another sheardiff version and cannot be continued",
+                     fmt::join(have_inner, ", "), fmt::join(inner, ", ")));
+  if (dims[0] < rows)
+    fail(file, full, fmt::format("holds {} rows, the checkpoint needs {}", dims[0], rows));
   dims[0] = rows;
   check(H5Dset_extent(s.ds.get(), dims.data()), file, full, "cannot truncate dataset");
+  s.inner = std::move(inner);
   s.rows = rows;
   return s;
 }
 
-// H5MD time-dependent element: group with step, time and value.
-struct TimeElement {
-  Handle group;
-  Series step, time, value;
-
-  void append(long st, double t, hid_t mem_type, const void* data, const fs::path& file) {
-    const std::int64_t st64 = st;
-    step.append(H5T_NATIVE_INT64, &st64, file);
-    time.append(H5T_NATIVE_DOUBLE, &t, file);
-    value.append(mem_type, data, file);
-  }
-};
-
-TimeElement create_element(hid_t loc, const std::string& full, std::vector<hsize_t> inner,
-                           hsize_t chunk_rows, const fs::path& file) {
-  TimeElement e;
-  e.group = create_group(loc, full, file);
-  e.step = create_series(loc, full + "/step", H5T_STD_I64LE, {}, kScalarChunk, file);
-  e.time = create_series(loc, full + "/time", H5T_IEEE_F64LE, {}, kScalarChunk, file);
-  e.value = create_series(loc, full + "/value", H5T_IEEE_F64LE, std::move(inner), chunk_rows, file);
-  return e;
+void hard_link(hid_t f, const std::string& target, const std::string& link, const fs::path& file) {
+  check(H5Lcreate_hard(f, target.c_str(), f, link.c_str(), H5P_DEFAULT, H5P_DEFAULT), file, link,
+        "cannot create hard link to " + target);
 }
 
 void check_name(const std::string& name, const fs::path& file, std::string_view what) {
@@ -245,27 +287,28 @@ void check_name(const std::string& name, const fs::path& file, std::string_view 
   }
 }
 
-// Read-only access with existence checks, so missing objects give a clean message
-// instead of an HDF5 error stack.
+// Read-only access with existence checks, so missing objects give a clean message; HDF5's own
+// error printing is off while a Reader lives (a foreign file's layout is no reason for noise).
 class Reader {
  public:
   explicit Reader(const fs::path& path) : path_(path) {
     std::error_code ec;
     if (!fs::exists(path_, ec)) fail(path_, "/", "file does not exist");
-    ErrorPrintGuard quiet;
     file_ = checked(H5Fopen(path_.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, path_,
                     "/", "cannot open file as HDF5");
   }
 
   const fs::path& path() const { return path_; }
+  hid_t id() const { return file_.get(); }
 
-  // H5Lexists fails (not false) on a missing intermediate group, so walk the components.
+  // H5Lexists fails (not false) below a missing or non-group component, so walk them.
   bool exists(const std::string& name) const {
     std::size_t pos = 0;
     while (pos != std::string::npos) {
       pos = name.find('/', pos + 1);
       const std::string prefix = name.substr(0, pos);
       if (H5Lexists(file_.get(), prefix.c_str(), H5P_DEFAULT) <= 0) return false;
+      if (pos != std::string::npos && !is_group(prefix)) return false;
     }
     return true;
   }
@@ -293,6 +336,60 @@ class Reader {
       fail(path_, name, "cannot query object");
     }
     return info.type == H5O_TYPE_GROUP;
+  }
+
+  std::vector<std::string> children(const std::string& group) const {
+    H5G_info_t info;
+    if (H5Gget_info_by_name(file_.get(), group.c_str(), &info, H5P_DEFAULT) < 0)
+      fail(path_, group, "cannot list group");
+    std::vector<std::string> out;
+    for (hsize_t k = 0; k < info.nlinks; ++k) {
+      const ssize_t len = H5Lget_name_by_idx(file_.get(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC,
+                                             k, nullptr, 0, H5P_DEFAULT);
+      if (len < 0) fail(path_, group, "cannot list group");
+      std::string name(static_cast<std::size_t>(len) + 1, '\0');
+      H5Lget_name_by_idx(file_.get(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC, k, name.data(),
+                         name.size(), H5P_DEFAULT);
+      name.resize(static_cast<std::size_t>(len));
+      out.push_back(name);
+    }
+    return out;
+  }
+
+  // Fixed- or variable-length string attribute, as a list.
+  std::vector<std::string> string_attr(const std::string& obj, const char* attr) const {
+    const std::string where = obj + "@" + attr;
+    if (H5Aexists_by_name(file_.get(), obj.c_str(), attr, H5P_DEFAULT) <= 0)
+      fail(path_, where, "attribute not found");
+    Handle a = checked(H5Aopen_by_name(file_.get(), obj.c_str(), attr, H5P_DEFAULT, H5P_DEFAULT),
+                       H5Aclose, path_, where, "cannot open attribute");
+    Handle type = checked(H5Aget_type(a.get()), H5Tclose, path_, where, "cannot get type");
+    if (H5Tget_class(type.get()) != H5T_STRING) fail(path_, where, "not a string attribute");
+    Handle space = checked(H5Aget_space(a.get()), H5Sclose, path_, where, "cannot get dataspace");
+    const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+    if (n < 0) fail(path_, where, "cannot get size");
+    std::vector<std::string> out;
+    if (H5Tis_variable_str(type.get()) > 0) {
+      Handle mem = checked(H5Tcopy(H5T_C_S1), H5Tclose, path_, where, "cannot create type");
+      H5Tset_size(mem.get(), H5T_VARIABLE);
+      H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
+      std::vector<char*> ptrs(static_cast<std::size_t>(n), nullptr);
+      check(H5Aread(a.get(), mem.get(), ptrs.data()), path_, where, "cannot read attribute");
+      for (char* p : ptrs) {
+        out.emplace_back(p != nullptr ? p : "");
+        H5free_memory(p);
+      }
+    } else {
+      const std::size_t size = H5Tget_size(type.get());
+      std::vector<char> buf(size * static_cast<std::size_t>(n) + 1, '\0');
+      check(H5Aread(a.get(), type.get(), buf.data()), path_, where, "cannot read attribute");
+      for (hssize_t k = 0; k < n; ++k) {
+        std::string v(buf.data() + static_cast<std::size_t>(k) * size, size);
+        v.resize(std::min(v.find('\0'), v.find_last_not_of(' ') + 1));
+        out.push_back(v);
+      }
+    }
+    return out;
   }
 
   // Rows [first, first+count) along dimension 0, flattened; `inner` receives the row shape.
@@ -327,7 +424,26 @@ class Reader {
   template <class T>
   std::vector<T> read_all(const std::string& name, hid_t mem_type,
                           std::vector<hsize_t>* inner = nullptr) const {
-    return read_rows<T>(name, mem_type, 0, rows(name), inner);
+    const auto d = dims(name);
+    if (d.empty()) {  // scalar dataspace
+      Handle ds = open_dataset(name);
+      std::vector<T> out(1);
+      check(H5Dread(ds.get(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()), path_, name,
+            "cannot read dataset");
+      if (inner != nullptr) inner->clear();
+      return out;
+    }
+    return read_rows<T>(name, mem_type, 0, d[0], inner);
+  }
+
+  template <class T>
+  std::optional<T> scalar_attr(const std::string& obj, const char* attr, hid_t mem_type) const {
+    if (H5Aexists_by_name(file_.get(), obj.c_str(), attr, H5P_DEFAULT) <= 0) return std::nullopt;
+    Handle a = checked(H5Aopen_by_name(file_.get(), obj.c_str(), attr, H5P_DEFAULT, H5P_DEFAULT),
+                       H5Aclose, path_, obj + "@" + attr, "cannot open attribute");
+    T v{};
+    check(H5Aread(a.get(), mem_type, &v), path_, obj + "@" + attr, "cannot read attribute");
+    return v;
   }
 
  private:
@@ -342,6 +458,7 @@ class Reader {
     return d;
   }
 
+  ErrorPrintGuard quiet_;  // first: restored after the file is closed
   fs::path path_;
   Handle file_;
 };
@@ -350,18 +467,55 @@ std::string susp(const char* rel) {
   return std::string(kSuspension) + "/" + rel;
 }
 
-long count_frames(const Reader& r) {
-  hsize_t n = r.rows(susp("position/value"));
-  n = std::min(n, r.rows(susp("position/step")));
-  n = std::min(n, r.rows(susp("position/time")));
-  const std::string edges = susp("box/edges/value");
-  if (r.exists(edges)) n = std::min(n, r.rows(edges));
+// The particle group to read: ours ("suspension"), the common "all", or the only one.
+std::string particle_group(const Reader& r) {
+  if (!r.exists("/particles") || !r.is_group("/particles"))
+    fail(r.path(), "/particles", "group not found");
+  const auto names = r.children("/particles");
+  for (const char* preferred : {"suspension", "all"})
+    if (std::find(names.begin(), names.end(), preferred) != names.end())
+      return std::string("/particles/") + preferred;
+  if (names.size() == 1) return "/particles/" + names[0];
+  fail(r.path(), "/particles",
+       fmt::format("holds the groups [{}]; expected one, or one named \"suspension\" or \"all\"",
+                   fmt::join(names, ", ")));
+}
+
+// Rows of a time-dependent element: value's, cut to explicit step and time (a crash may
+// leave them a row apart in files written without hard links).
+hsize_t element_rows(const Reader& r, const std::string& element) {
+  hsize_t n = r.rows(element + "/value");
+  for (const char* axis : {"/step", "/time"}) {
+    const std::string name = element + axis;
+    if (!r.exists(name)) continue;
+    const auto d = r.dims(name);
+    if (!d.empty()) n = std::min(n, d[0]);
+  }
+  return n;
+}
+
+long count_frames(const Reader& r, const std::string& group) {
+  hsize_t n = element_rows(r, group + "/position");
+  const std::string edges = group + "/box/edges";
+  if (r.exists(edges) && r.is_group(edges)) n = std::min(n, element_rows(r, edges));
   return static_cast<long>(n);
 }
 
-std::vector<Vec2> to_vec2(const std::vector<double>& flat) {
-  std::vector<Vec2> out(flat.size() / 2);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Vec2(flat[2 * i], flat[2 * i + 1]);
+// Step or time of row idx, in either H5MD 1.1 storage mode (explicit, or fixed increment
+// with an optional offset).
+template <class T>
+T axis_value(const Reader& r, const std::string& name, hid_t mem_type, hsize_t idx) {
+  if (r.dims(name).empty()) {
+    const T inc = r.read_all<T>(name, mem_type)[0];
+    const T offset = r.scalar_attr<T>(name, "offset", mem_type).value_or(T{});
+    return static_cast<T>(idx) * inc + offset;
+  }
+  return r.read_rows<T>(name, mem_type, idx, 1)[0];
+}
+
+std::vector<Vec2> to_vec2(const std::vector<double>& flat, std::size_t dim) {
+  std::vector<Vec2> out(flat.size() / dim);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = Vec2(flat[dim * i], flat[dim * i + 1]);
   return out;
 }
 
@@ -374,22 +528,79 @@ void expect_shape(const Reader& r, const std::string& name, const std::vector<hs
   }
 }
 
+// Units in the project's reduced units (docs/units.md, docs/trajectory.md): d the small
+// diameter, P the imposed pressure, eta the fluid viscosity.
+constexpr const char* kLength = "d";
+constexpr const char* kTime = "eta P-1";
+constexpr const char* kVelocity = "P d eta-1";
+constexpr const char* kRate = "P eta-1";
+constexpr const char* kForce = "P d+2";
+constexpr const char* kNumber = "1";
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
 // Writer
 
+namespace {
+
+const std::string kStep = susp("position/step");
+const std::string kTimeName = susp("position/time");
+constexpr const char* kContacts = "/connectivity/contacts";
+
+std::string author_name(const std::string& given) {
+  if (!given.empty()) return given;
+  if (const char* env = std::getenv("SHEARDIFF_AUTHOR"); env != nullptr && *env != '\0') return env;
+  // The real name of the passwd entry (its first GECOS field), else the login.
+  if (const passwd* pw = getpwuid(getuid()); pw != nullptr) {
+    std::string gecos = pw->pw_gecos != nullptr ? pw->pw_gecos : "";
+    gecos = gecos.substr(0, gecos.find(','));
+    if (!gecos.empty()) return gecos;
+    if (pw->pw_name != nullptr && *pw->pw_name != '\0') return pw->pw_name;
+  }
+  return "unknown";
+}
+
+// Where the Lees-Edwards shift is reduced to [-lx/2, lx/2] (LAMMPS's limit; the same lattice).
+double reduced_tilt(double tilt, double lx) {
+  return tilt - lx * std::round(tilt / lx);
+}
+
+}  // namespace
+
 struct H5mdWriter::Impl {
   fs::path path;
   TrajectoryLayout layout;
   Handle file;  // declared first so it is closed after all objects inside it
-  TimeElement edges, position, velocity, angular_velocity;
-  std::optional<TimeElement> unwrapped;
-  std::vector<TimeElement> observables;
+  // position's step and time: every other time-dependent element hard-links them.
+  Series step, time;
+  Series edges, position, velocity, angular_velocity;
+  std::optional<Series> image, unwrapped;
+  std::vector<Series> observables;
+  std::optional<Series> pairs, normal_force, tangential_force, sliding;
   long frames = 0;
+  double max_diameter = 0;
 
   ~Impl() {
     if (file.valid()) H5Fflush(file.get(), H5F_SCOPE_LOCAL);
+  }
+
+  // An element group whose step and time are position's and whose value is a new series.
+  Series element(const std::string& full, hid_t file_type, std::vector<hsize_t> inner,
+                 hsize_t chunk_rows, const std::string& unit) {
+    const hid_t f = file.get();
+    Handle g = create_group(f, full, path);
+    hard_link(f, kStep, full + "/step", path);
+    hard_link(f, kTimeName, full + "/time", path);
+    Series s = create_series(f, full + "/value", file_type, std::move(inner), chunk_rows, path);
+    write_unit(s.ds.get(), s.name, unit, path);
+    return s;
+  }
+
+  void create_unwrapped() {
+    const hsize_t n = layout.n_particles;
+    image = element(susp("image"), H5T_STD_I32LE, {n, 2}, 1, kNumber);
+    unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, 2}, 1, kLength);
   }
 };
 
@@ -405,6 +616,11 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
          fmt::format("layout arrays sizes species={} diameter={} motion={} != n_particles={}",
                      layout.species.size(), layout.diameter.size(), layout.motion.size(), n));
   }
+  if (!layout.observable_units.empty() &&
+      layout.observable_units.size() != layout.observables.size())
+    fail(path, "/observables",
+         fmt::format("{} units for {} observables", layout.observable_units.size(),
+                     layout.observables.size()));
   for (std::size_t i = 0; i < layout.observables.size(); ++i) {
     check_name(layout.observables[i], path, "observable");
     for (std::size_t j = 0; j < i; ++j) {
@@ -413,6 +629,7 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
       }
     }
   }
+  for (double d : layout.diameter) m.max_diameter = std::max(m.max_diameter, d);
 
   {
     ErrorPrintGuard quiet;
@@ -425,11 +642,22 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     Handle h5md = create_group(f, "/h5md", path);
     write_int_attr(h5md.get(), "/h5md", "version", {1, 1}, false, path);
     Handle author = create_group(f, "/h5md/author", path);
-    write_string_attr(author.get(), "/h5md/author", "name", {"sheardiff"}, true, path);
+    write_string_attr(author.get(), "/h5md/author", "name", {author_name(layout.author)}, true,
+                      path, Str::Fixed);
     Handle creator = create_group(f, "/h5md/creator", path);
-    write_string_attr(creator.get(), "/h5md/creator", "name", {"sheardiff"}, true, path);
+    write_string_attr(creator.get(), "/h5md/creator", "name", {"sheardiff"}, true, path,
+                      Str::Fixed);
     write_string_attr(creator.get(), "/h5md/creator", "version", {layout.creator_version}, true,
-                      path);
+                      path, Str::Fixed);
+    Handle modules = create_group(f, "/h5md/modules", path);
+    Handle units = create_group(f, "/h5md/modules/units", path);
+    write_int_attr(units.get(), "/h5md/modules/units", "version", {1, 0}, false, path);
+    write_string_attr(units.get(), "/h5md/modules/units", "system", {"reduced"}, true, path,
+                      Str::VlAscii);
+    write_string_attr(units.get(), "/h5md/modules/units", "symbols",
+                      {"d: diameter of the small particles; P: imposed (reference) pressure; "
+                       "eta: viscosity of the suspending fluid; 1: dimensionless"},
+                      true, path);
   }
   {
     Handle parameters = create_group(f, "/parameters", path);
@@ -443,24 +671,74 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     Handle box = create_group(f, box_name, path);
     write_int_attr(box.get(), box_name, "dimension", {2}, true, path);
     write_string_attr(box.get(), box_name, "boundary",
-                      {"periodic", layout.lees_edwards ? "periodic" : "none"}, false, path);
+                      {"periodic", layout.lees_edwards ? "periodic" : "none"}, false, path,
+                      Str::Fixed);
   }
-  m.edges = create_element(f, susp("box/edges"), {2}, kScalarChunk, path);
-  m.position = create_element(f, susp("position"), {n, 2}, 1, path);
+  {
+    Handle position_group = create_group(f, susp("position"), path);
+    m.step = create_series(f, kStep, H5T_STD_I64LE, {}, kScalarChunk, path);
+    m.time = create_series(f, kTimeName, H5T_IEEE_F64LE, {}, kScalarChunk, path);
+    write_unit(m.time.ds.get(), kTimeName, kTime, path);
+    m.position = create_series(f, susp("position/value"), H5T_IEEE_F64LE, {n, 2}, 1, path);
+    write_unit(m.position.ds.get(), m.position.name, kLength, path);
+  }
+  m.edges = m.element(susp("box/edges"), H5T_IEEE_F64LE, {2, 2}, kScalarChunk, kLength);
   if (layout.write_velocity) {
-    m.velocity = create_element(f, susp("velocity"), {n, 2}, 1, path);
-    m.angular_velocity = create_element(f, susp("angular_velocity"), {n}, 1, path);
+    m.velocity = m.element(susp("velocity"), H5T_IEEE_F64LE, {n, 2}, 1, kVelocity);
+    m.angular_velocity = m.element(susp("angular_velocity"), H5T_IEEE_F64LE, {n}, 1, kRate);
   }
-  write_fixed_dataset(f, susp("species"), H5T_STD_I32LE, H5T_NATIVE_INT, {n}, layout.species.data(),
-                      path);
+  {
+    // HDF5 converts enumerations to numbers on reading, not numbers to enumerations.
+    const auto codes = [](const std::vector<int>& v) {
+      return std::vector<std::int8_t>(v.begin(), v.end());
+    };
+    Handle species = enum_type({{"small", 0}, {"large", 1}}, path, susp("species"));
+    write_fixed_dataset(f, susp("species"), species.get(), species.get(), {n},
+                        codes(layout.species).data(), kNumber, path);
+    Handle motion =
+        enum_type({{"mobile", 0}, {"fixed_wall", 1}, {"floating_wall", 2}}, path, susp("motion"));
+    write_fixed_dataset(f, susp("motion"), motion.get(), motion.get(), {n},
+                        codes(layout.motion).data(), kNumber, path);
+  }
   write_fixed_dataset(f, susp("diameter"), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n},
-                      layout.diameter.data(), path);
-  write_fixed_dataset(f, susp("motion"), H5T_STD_I32LE, H5T_NATIVE_INT, {n}, layout.motion.data(),
-                      path);
+                      layout.diameter.data(), kLength, path);
 
   Handle obs_group = create_group(f, "/observables", path);
-  for (const auto& name : layout.observables) {
-    m.observables.push_back(create_element(f, "/observables/" + name, {}, kScalarChunk, path));
+  for (std::size_t k = 0; k < layout.observables.size(); ++k) {
+    const std::string unit = layout.observable_units.empty() ? kNumber : layout.observable_units[k];
+    m.observables.push_back(
+        m.element("/observables/" + layout.observables[k], H5T_IEEE_F64LE, {}, kScalarChunk, unit));
+  }
+
+  if (layout.write_contacts) {
+    Handle connectivity = create_group(f, "/connectivity", path);
+    Handle contacts = create_group(f, kContacts, path);
+    hobj_ref_t ref;
+    check(H5Rcreate(&ref, f, kSuspension, H5R_OBJECT, -1), path, kContacts,
+          "cannot reference the particle group");
+    {
+      const std::string where = std::string(kContacts) + "@particles_group";
+      Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, path, where, "dataspace");
+      Handle a = checked(H5Acreate2(contacts.get(), "particles_group", H5T_STD_REF_OBJ, space.get(),
+                                    H5P_DEFAULT, H5P_DEFAULT),
+                         H5Aclose, path, where, "cannot create attribute");
+      check(H5Awrite(a.get(), H5T_STD_REF_OBJ, &ref), path, where, "cannot write attribute");
+    }
+    const std::string c = kContacts;
+    hard_link(f, kStep, c + "/step", path);
+    hard_link(f, kTimeName, c + "/time", path);
+    const std::int32_t no_pair = -1;
+    const double no_force = std::numeric_limits<double>::quiet_NaN();
+    const std::int8_t no_flag = -1;
+    m.pairs = create_series(f, c + "/value", H5T_STD_I32LE, {0, 2}, 1, path, &no_pair);
+    m.normal_force = create_series(f, c + "/normal_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+    m.tangential_force =
+        create_series(f, c + "/tangential_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+    m.sliding = create_series(f, c + "/sliding", H5T_STD_I8LE, {0}, 1, path, &no_flag);
+    write_unit(m.pairs->ds.get(), m.pairs->name, kNumber, path);
+    write_unit(m.normal_force->ds.get(), m.normal_force->name, kForce, path);
+    write_unit(m.tangential_force->ds.get(), m.tangential_force->name, kForce, path);
+    write_unit(m.sliding->ds.get(), m.sliding->name, kNumber, path);
   }
   check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
 }
@@ -472,6 +750,7 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   auto m = std::make_unique<Impl>();
   m->path = path;
   m->layout = layout;
+  for (double d : layout.diameter) m->max_diameter = std::max(m->max_diameter, d);
   {
     ErrorPrintGuard quiet;
     m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, path,
@@ -480,24 +759,31 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   const hid_t f = m->file.get();
   const auto rows = static_cast<hsize_t>(keep_frames);
   const hsize_t n = layout.n_particles;
-  const auto element = [&](const std::string& full, std::vector<hsize_t> inner) {
-    TimeElement e;
-    e.group = checked(H5Gopen2(f, full.c_str(), H5P_DEFAULT), H5Gclose, path, full,
-                      "cannot open group");
-    e.step = open_series(f, full + "/step", {}, rows, path);
-    e.time = open_series(f, full + "/time", {}, rows, path);
-    e.value = open_series(f, full + "/value", std::move(inner), rows, path);
-    return e;
+  const auto value = [&](const std::string& full, std::vector<hsize_t> inner, bool ragged = false) {
+    return open_series(f, full, std::move(inner), rows, path, ragged);
   };
-  m->edges = element(susp("box/edges"), {2});
-  m->position = element(susp("position"), {n, 2});
+  // Hard links: cutting position's step and time cuts every element's.
+  m->step = value(kStep, {});
+  m->time = value(kTimeName, {});
+  m->position = value(susp("position/value"), {n, 2});
+  m->edges = value(susp("box/edges/value"), {2, 2});
   if (layout.write_velocity) {
-    m->velocity = element(susp("velocity"), {n, 2});
-    m->angular_velocity = element(susp("angular_velocity"), {n});
+    m->velocity = value(susp("velocity/value"), {n, 2});
+    m->angular_velocity = value(susp("angular_velocity/value"), {n});
   }
-  if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0)
-    m->unwrapped = element(susp("unwrapped_position"), {n, 2});
-  for (const auto& name : layout.observables) m->observables.push_back(element("/observables/" + name, {}));
+  if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0) {
+    m->image = value(susp("image/value"), {n, 2});
+    m->unwrapped = value(susp("unwrapped_position/value"), {n, 2});
+  }
+  for (const auto& name : layout.observables)
+    m->observables.push_back(value("/observables/" + name + "/value", {}));
+  if (layout.write_contacts) {
+    const std::string c = kContacts;
+    m->pairs = value(c + "/value", {0, 2}, true);
+    m->normal_force = value(c + "/normal_force", {0}, true);
+    m->tangential_force = value(c + "/tangential_force", {0}, true);
+    m->sliding = value(c + "/sliding", {0}, true);
+  }
   m->frames = keep_frames;
   check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
   return H5mdWriter(std::move(m));
@@ -539,13 +825,40 @@ void H5mdWriter::write_frame(const FrameData& frame) {
          fmt::format("frame has {} observable values, layout names {}", frame.observables.size(),
                      m.layout.observables.size()));
   }
+  if (m.layout.write_contacts) {
+    const ContactNetwork* c = frame.contacts;
+    if (c == nullptr) fail(m.path, kContacts, "frame without its contact network");
+    const std::size_t k = c->pairs.size();
+    if (c->normal_force.size() != k || c->tangential_force.size() != k || c->sliding.size() != k)
+      fail(m.path, kContacts, "contact arrays of different lengths");
+    for (const auto& pr : c->pairs)
+      for (int i : pr)
+        if (i < 0 || static_cast<std::size_t>(i) >= n)
+          fail(m.path, kContacts, fmt::format("particle index {} out of [0, {})", i, n));
+  }
+  if (!(frame.lx > 0.0) || (m.layout.lees_edwards && !(frame.ly > 0.0)) ||
+      !std::isfinite(frame.tilt))
+    fail(m.path, susp("box/edges"),
+         fmt::format("invalid box lx = {}, ly = {}, tilt = {}", frame.lx, frame.ly, frame.tilt));
 
-  if (m.frames == 0 && want_unwrapped) {
-    m.unwrapped = create_element(m.file.get(), susp("unwrapped_position"), {n, 2}, 1, m.path);
+  if (m.frames == 0 && want_unwrapped) m.create_unwrapped();
+
+  const std::vector<Vec2>& pos = *frame.position;
+  const double lx = frame.lx;
+  const double tilt = m.layout.lees_edwards ? reduced_tilt(frame.tilt, lx) : 0.0;
+  double ly = frame.ly;
+  if (!m.layout.lees_edwards) {
+    // Placeholder: tall enough that a tool taking y as periodic anyway finds no false contact.
+    double lo = pos[0].y(), hi = pos[0].y();
+    for (const Vec2& x : pos) lo = std::min(lo, x.y()), hi = std::max(hi, x.y());
+    ly = hi - lo + 2.0 * m.max_diameter;
   }
 
-  const double edges[2] = {frame.lx, frame.ly};
-  m.edges.append(frame.step, frame.time, H5T_NATIVE_DOUBLE, edges, m.path);
+  const std::int64_t st64 = frame.step;
+  m.step.append(H5T_NATIVE_INT64, &st64, m.path);
+  m.time.append(H5T_NATIVE_DOUBLE, &frame.time, m.path);
+  const double edges[4] = {lx, 0.0, tilt, ly};  // rows: the edge vectors (lx, 0) and (tilt, ly)
+  m.edges.append(H5T_NATIVE_DOUBLE, edges, m.path);
 
   std::vector<double> buf(2 * n);
   const auto flatten2 = [&](const std::vector<Vec2>& v) {
@@ -554,11 +867,21 @@ void H5mdWriter::write_frame(const FrameData& frame) {
       buf[2 * i + 1] = v[i].y();
     }
   };
-  flatten2(*frame.position);
-  m.position.append(frame.step, frame.time, H5T_NATIVE_DOUBLE, buf.data(), m.path);
+  flatten2(pos);
+  m.position.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
   if (m.unwrapped) {
-    flatten2(*frame.unwrapped);
-    m.unwrapped->append(frame.step, frame.time, H5T_NATIVE_DOUBLE, buf.data(), m.path);
+    // position + image . edges: exact in y; in x the Lees-Edwards shift moved on since each
+    // crossing, which is why the integrated displacement is kept beside it.
+    const std::vector<Vec2>& u = *frame.unwrapped;
+    std::vector<std::int32_t> img(2 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double iy = m.layout.lees_edwards ? std::round((u[i].y() - pos[i].y()) / ly) : 0.0;
+      img[2 * i] = static_cast<std::int32_t>(std::round((u[i].x() - pos[i].x() - iy * tilt) / lx));
+      img[2 * i + 1] = static_cast<std::int32_t>(iy);
+    }
+    m.image->append(H5T_NATIVE_INT32, img.data(), m.path);
+    flatten2(u);
+    m.unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
   }
   if (m.layout.write_velocity) {
     const auto& v = *frame.velocity;
@@ -568,40 +891,51 @@ void H5mdWriter::write_frame(const FrameData& frame) {
       buf[2 * i + 1] = v[i].y();
       omega[i] = v[i].z();
     }
-    m.velocity.append(frame.step, frame.time, H5T_NATIVE_DOUBLE, buf.data(), m.path);
-    m.angular_velocity.append(frame.step, frame.time, H5T_NATIVE_DOUBLE, omega.data(), m.path);
+    m.velocity.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
+    m.angular_velocity.append(H5T_NATIVE_DOUBLE, omega.data(), m.path);
   }
-  for (std::size_t k = 0; k < m.observables.size(); ++k) {
-    m.observables[k].append(frame.step, frame.time, H5T_NATIVE_DOUBLE, &frame.observables[k],
-                            m.path);
+  for (std::size_t k = 0; k < m.observables.size(); ++k)
+    m.observables[k].append(H5T_NATIVE_DOUBLE, &frame.observables[k], m.path);
+  if (m.layout.write_contacts) {
+    const ContactNetwork& c = *frame.contacts;
+    const hsize_t k = c.pairs.size();
+    std::vector<std::int32_t> ij(2 * k);
+    std::vector<std::int8_t> flag(k);
+    for (hsize_t q = 0; q < k; ++q) {
+      ij[2 * q] = c.pairs[q][0];
+      ij[2 * q + 1] = c.pairs[q][1];
+      flag[q] = c.sliding[q] != 0 ? 1 : 0;
+    }
+    m.pairs->append(H5T_NATIVE_INT32, ij.data(), m.path, k);
+    m.normal_force->append(H5T_NATIVE_DOUBLE, c.normal_force.data(), m.path, k);
+    m.tangential_force->append(H5T_NATIVE_DOUBLE, c.tangential_force.data(), m.path, k);
+    m.sliding->append(H5T_NATIVE_INT8, flag.data(), m.path, k);
   }
   ++m.frames;
 }
 
 void H5mdWriter::write_table(const std::string& name, const std::vector<std::string>& columns,
-                             const Eigen::MatrixXd& values) {
+                             const std::vector<std::string>& units, const Eigen::MatrixXd& values) {
   if (!impl_) throw std::logic_error("H5mdWriter: write_table on a moved-from writer");
   Impl& m = *impl_;
   check_name(name, m.path, "table");
   const std::string group_name = "/observables/" + name;
-  if (columns.size() != static_cast<std::size_t>(values.cols())) {
+  if (columns.size() != static_cast<std::size_t>(values.cols()) || units.size() != columns.size()) {
     fail(m.path, group_name,
-         fmt::format("{} column names for {} columns", columns.size(), values.cols()));
+         fmt::format("{} column names and {} units for {} columns", columns.size(), units.size(),
+                     values.cols()));
   }
+  for (const auto& c : columns) check_name(c, m.path, "column");
   if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0) {
     fail(m.path, group_name, "object already exists");
   }
   Handle group = create_group(m.file.get(), group_name, m.path);
-  // HDF5 is row-major, Eigen's default column-major.
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const RowMajor rm = values;
-  const std::string value_name = group_name + "/value";
-  write_fixed_dataset(m.file.get(), value_name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                      {static_cast<hsize_t>(values.rows()), static_cast<hsize_t>(values.cols())},
-                      rm.data(), m.path);
-  Handle ds = checked(H5Dopen2(m.file.get(), value_name.c_str(), H5P_DEFAULT), H5Dclose, m.path,
-                      value_name, "cannot open dataset");
-  write_string_attr(ds.get(), value_name, "columns", columns, false, m.path);
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    const Eigen::VectorXd col = values.col(static_cast<Eigen::Index>(c));
+    write_fixed_dataset(m.file.get(), group_name + "/" + columns[c], H5T_IEEE_F64LE,
+                        H5T_NATIVE_DOUBLE, {static_cast<hsize_t>(values.rows())}, col.data(),
+                        units[c], m.path);
+  }
 }
 
 void H5mdWriter::flush() {
@@ -616,81 +950,120 @@ long H5mdWriter::frames_written() const {
 // ---------------------------------------------------------------------------------------
 // Reader
 
+namespace {
+
+hsize_t frame_index(const Reader& r, const std::string& group, long frame) {
+  const long frames = count_frames(r, group);
+  if (frame < -1 || frame >= frames || (frame == -1 && frames == 0)) {
+    fail(r.path(), group + "/position/value",
+         fmt::format("frame {} out of range ({} frames)", frame, frames));
+  }
+  return static_cast<hsize_t>(frame == -1 ? frames - 1 : frame);
+}
+
+// Positions or velocities of row idx: (N, D) with D = 2, or 3 of which x and y are kept.
+std::vector<Vec2> read_vectors(const Reader& r, const std::string& name, hsize_t idx,
+                               std::optional<hsize_t> n) {
+  std::vector<hsize_t> inner;
+  const auto flat = r.read_rows<double>(name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
+  if (inner.size() != 2 || (inner[1] != 2 && inner[1] != 3) || (n && inner[0] != *n)) {
+    fail(r.path(), name,
+         fmt::format("unexpected shape (frames, {}), expected (frames, {}, 2 or 3)",
+                     fmt::join(inner, ", "), n ? std::to_string(*n) : "N"));
+  }
+  return to_vec2(flat, inner[1]);
+}
+
+}  // namespace
+
 long count_h5md_frames(const fs::path& file) {
   const Reader r(file);
-  return count_frames(r);
+  return count_frames(r, particle_group(r));
 }
 
 H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
   const Reader r(file);
-  const long frames = count_frames(r);
-  const std::string pos_name = susp("position/value");
-  if (frame < -1 || frame >= frames || (frame == -1 && frames == 0)) {
-    fail(file, pos_name, fmt::format("frame {} out of range ({} frames)", frame, frames));
-  }
-  const auto idx = static_cast<hsize_t>(frame == -1 ? frames - 1 : frame);
+  const std::string g = particle_group(r);
+  const hsize_t idx = frame_index(r, g, frame);
 
   H5mdFrame out;
-  std::vector<hsize_t> inner;
-  const auto pos = r.read_rows<double>(pos_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
-  if (inner.size() != 2 || inner[1] != 2) {
-    fail(file, pos_name,
-         fmt::format("unexpected shape (frames, {}), expected (frames, N, 2)",
-                     fmt::join(inner, ", ")));
-  }
-  const hsize_t n = inner[0];
-  out.position = to_vec2(pos);
-  out.step = static_cast<long>(
-      r.read_rows<std::int64_t>(susp("position/step"), H5T_NATIVE_INT64, idx, 1)[0]);
-  out.time = r.read_rows<double>(susp("position/time"), H5T_NATIVE_DOUBLE, idx, 1)[0];
+  out.position = read_vectors(r, g + "/position/value", idx, std::nullopt);
+  const hsize_t n = out.position.size();
+  out.step =
+      static_cast<long>(axis_value<std::int64_t>(r, g + "/position/step", H5T_NATIVE_INT64, idx));
+  if (r.exists(g + "/position/time"))
+    out.time = axis_value<double>(r, g + "/position/time", H5T_NATIVE_DOUBLE, idx);
 
-  const std::string edges_name = susp("box/edges");
-  if (!r.exists(edges_name)) fail(file, edges_name, "object not found");
-  std::vector<double> edges;
-  if (r.is_group(edges_name)) {
-    edges = r.read_rows<double>(edges_name + "/value", H5T_NATIVE_DOUBLE, idx, 1, &inner);
-    expect_shape(r, edges_name + "/value", inner, {2});
-  } else {  // H5MD also allows a time-independent box
-    edges = r.read_all<double>(edges_name, H5T_NATIVE_DOUBLE, &inner);
-    expect_shape(r, edges_name, inner, {});
-    if (edges.size() != 2) fail(file, edges_name, "expected 2 edges");
+  const std::string box = g + "/box";
+  if (!r.exists(box)) fail(file, box, "object not found");
+  const auto boundary = r.string_attr(box, "boundary");
+  if (boundary.size() < 2) fail(file, box + "@boundary", "expected 2 or 3 entries");
+  out.periodic_y = boundary[1] == "periodic";
+  const std::string edges_name = box + "/edges";
+  if (r.exists(edges_name)) {
+    std::vector<hsize_t> inner;
+    std::vector<double> e;
+    std::string where = edges_name;
+    if (r.is_group(edges_name)) {  // time-dependent
+      where += "/value";
+      e = r.read_rows<double>(where, H5T_NATIVE_DOUBLE, idx, 1, &inner);
+    } else {
+      e = r.read_all<double>(where, H5T_NATIVE_DOUBLE, &inner);
+      inner = r.dims(where);
+    }
+    const hsize_t dim = inner.empty() ? 0 : inner[0];
+    if (dim != 2 && dim != 3) fail(file, where, "expected the edges of a 2D or 3D box");
+    if (inner.size() == 1) {  // cuboid: the space diagonal
+      out.lx = e[0];
+      out.ly = e[1];
+    } else if (inner.size() == 2 && inner[1] == dim) {  // triclinic: edge vectors as rows
+      out.lx = e[0];
+      out.tilt = e[dim];
+      out.ly = e[dim + 1];
+      if (e[1] != 0.0)
+        fail(file, where,
+             fmt::format("the first edge vector ({}, {}) is not along x: only boxes with edges "
+                         "(lx, 0) and (xy, ly) (LAMMPS, GSD) can be read",
+                         e[0], e[1]));
+    } else {
+      fail(file, where, fmt::format("unexpected shape ({})", fmt::join(inner, ", ")));
+    }
   }
-  out.lx = edges[0];
-  out.ly = edges[1];
 
-  const std::string unwrapped_name = susp("unwrapped_position/value");
-  if (r.exists(unwrapped_name)) {
-    out.unwrapped = to_vec2(r.read_rows<double>(unwrapped_name, H5T_NATIVE_DOUBLE, idx, 1, &inner));
-    expect_shape(r, unwrapped_name, inner, {n, 2});
-  }
+  const std::string unwrapped_name = g + "/unwrapped_position/value";
+  if (r.exists(unwrapped_name)) out.unwrapped = read_vectors(r, unwrapped_name, idx, n);
 
-  const std::string vel_name = susp("velocity/value");
-  const std::string omega_name = susp("angular_velocity/value");
+  const std::string vel_name = g + "/velocity/value";
+  const std::string omega_name = g + "/angular_velocity/value";
   const bool has_vel = r.exists(vel_name);
   const bool has_omega = r.exists(omega_name);
   if (has_vel || has_omega) {
     out.velocity.assign(n, Vec3::Zero());
     if (has_vel) {
-      const auto v = r.read_rows<double>(vel_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
-      expect_shape(r, vel_name, inner, {n, 2});
-      for (std::size_t i = 0; i < n; ++i) {
-        out.velocity[i].x() = v[2 * i];
-        out.velocity[i].y() = v[2 * i + 1];
-      }
+      const auto v = read_vectors(r, vel_name, idx, n);
+      for (std::size_t i = 0; i < n; ++i) out.velocity[i].head<2>() = v[i];
     }
     if (has_omega) {
+      std::vector<hsize_t> inner;
       const auto w = r.read_rows<double>(omega_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
       expect_shape(r, omega_name, inner, {n});
       for (std::size_t i = 0; i < n; ++i) out.velocity[i].z() = w[i];
     }
   }
 
-  // Optional so files from other H5MD writers still load.
+  // Optional so files from other H5MD writers still load; time-independent or not.
   const auto per_particle = [&](const char* rel, hid_t mem_type, auto& dest) {
-    const std::string name = susp(rel);
+    std::string name = g + "/" + rel;
     if (!r.exists(name)) return;
     using T = typename std::decay_t<decltype(dest)>::value_type;
-    dest = r.read_all<T>(name, mem_type, &inner);
+    std::vector<hsize_t> inner;
+    if (r.is_group(name)) {
+      name += "/value";
+      dest = r.read_rows<T>(name, mem_type, idx, 1, &inner);
+    } else {
+      dest = r.read_all<T>(name, mem_type, &inner);
+      inner.clear();
+    }
     expect_shape(r, name, inner, {});
     if (dest.size() != n) {
       fail(file, name, fmt::format("{} entries, position has {}", dest.size(), n));
@@ -700,6 +1073,31 @@ H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
   per_particle("species", H5T_NATIVE_INT, out.species);
   per_particle("motion", H5T_NATIVE_INT, out.motion);
   return out;
+}
+
+ContactNetwork read_h5md_contacts(const fs::path& file, long frame) {
+  const Reader r(file);
+  const std::string g = particle_group(r);
+  const hsize_t idx = frame_index(r, g, frame);
+  ContactNetwork c;
+  const std::string base = kContacts;
+  if (!r.exists(base + "/value")) return c;
+  std::vector<hsize_t> inner;
+  const auto ij = r.read_rows<std::int32_t>(base + "/value", H5T_NATIVE_INT32, idx, 1, &inner);
+  if (inner.size() != 2 || inner[1] != 2) fail(file, base + "/value", "expected (frames, M, 2)");
+  const auto fn = r.read_rows<double>(base + "/normal_force", H5T_NATIVE_DOUBLE, idx, 1);
+  const auto ft = r.read_rows<double>(base + "/tangential_force", H5T_NATIVE_DOUBLE, idx, 1);
+  const auto sl = r.read_rows<std::int8_t>(base + "/sliding", H5T_NATIVE_INT8, idx, 1);
+  if (fn.size() != inner[0] || ft.size() != inner[0] || sl.size() != inner[0])
+    fail(file, base, "per-contact datasets of different widths");
+  for (std::size_t q = 0; q < inner[0]; ++q) {
+    if (ij[2 * q] < 0 || ij[2 * q + 1] < 0) continue;  // the fill value: no contact
+    c.pairs.push_back({ij[2 * q], ij[2 * q + 1]});
+    c.normal_force.push_back(fn[q]);
+    c.tangential_force.push_back(ft[q]);
+    c.sliding.push_back(sl[q]);
+  }
+  return c;
 }
 
 ObservableSeries read_h5md_observable(const fs::path& file, const std::string& name) {

@@ -8,6 +8,10 @@ std::vector<std::string> RheologyObserver::frame_names() const {
   return {"strain", "shear_stress", "pressure", "sigma_xx", "sigma_yy", "contacts", "max_overlap"};
 }
 
+std::vector<std::string> RheologyObserver::frame_units() const {
+  return {"1", "P", "P", "P", "P", "1", "d"};
+}
+
 void RheologyObserver::on_frame(const StepView& v, std::vector<double>& values) {
   const StressSample& s = v.stress;
   values.insert(values.end(), {v.dynamics.strain(), s.shear_stress(), s.pressure(), s.sxx, s.syy,

@@ -120,6 +120,10 @@ std::vector<std::string> PressureCellObserver::frame_names() const {
   return {"H", "phi", "mu_top", "mu_bottom", "pressure_measured", "wall_velocity_y"};
 }
 
+std::vector<std::string> PressureCellObserver::frame_units() const {
+  return {"d", "1", "1", "1", "P", "P d eta-1"};
+}
+
 void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& values) {
   const Dynamics& d = v.dynamics;
   const double a = d.box().lx * lz_;
@@ -221,8 +225,8 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
                     error_block_);
   profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
   if (writer && !profiles_.empty())
-    writer->write_table("profiles", {"y", "phi", "u_x", "T"}, profiles_.table());
-
+    writer->write_table("profiles", {"y", "phi", "u_x", "T"},
+                        {"d", "1", "P d eta-1", "P+2 d+2 eta-2"}, profiles_.table());
 }
 
 }  // namespace sheardiff

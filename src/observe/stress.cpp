@@ -65,4 +65,21 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
   return s;
 }
 
+ContactNetwork contact_network(const Dynamics& d) {
+  ContactNetwork c;
+  const Particles& p = d.particles();
+  const FrictionalContact& law = d.force_balance().contact();
+  for (const Pair& pr : d.neighbours().pairs()) {
+    if (!pr.contact.active) continue;
+    // Geometry of now, not of the last solve: the frame shows the positions of now.
+    const Vec2 rij = p.position[pr.j] + d.box().image_shift(pr.kx, pr.ky) - p.position[pr.i];
+    const PairGeometry g = PairGeometry::make(rij, p.radius[pr.i], p.radius[pr.j]);
+    c.pairs.push_back({pr.i, pr.j});
+    c.normal_force.push_back(law.kn * std::max(g.overlap(), 0.0));
+    c.tangential_force.push_back(-law.kt * pr.contact.xi);  // spring force on j along z x n
+    c.sliding.push_back(pr.contact.sliding ? 1 : 0);
+  }
+  return c;
+}
+
 }  // namespace sheardiff

@@ -25,6 +25,7 @@ Packing packing_from_file(const Config& cfg) {
     }
     pk.lx = f.lx;
     pk.ly = f.ly;
+    if (f.periodic_y) pk.tilt = f.tilt;
   } else {
     TableConfiguration t = read_position_table(file);
     pk.position = t.position;
@@ -69,6 +70,7 @@ Scene build_simple_shear(const Config& cfg) {
   sc.box.lx = pk.lx;
   sc.box.ly = pk.ly;
   sc.box.lees_edwards = true;
+  sc.box.le_offset = pk.tilt;
   sc.box.gammadot = cfg.flow.j;
   sc.flow.gammadot = cfg.flow.j;
   sc.flow.y0 = 0.0;

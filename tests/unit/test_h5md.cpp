@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -55,6 +57,9 @@ Vec3 vel(int f, std::size_t i) {
 double ly_at(int f) {
   return 8.0 - 0.5 * f;
 }
+double tilt_at(int f) {
+  return 7.0 + f;  // stored reduced into [-3, 3]: 1, 2, -3
+}
 long step_at(int f) {
   return 100 * f + 7;
 }
@@ -99,6 +104,7 @@ void write_test_file(const fs::path& file) {
     fd.time = time_at(f);
     fd.lx = 6;
     fd.ly = ly_at(f);
+    fd.tilt = tilt_at(f);
     fd.position = &p;
     fd.unwrapped = &u;
     fd.velocity = &v;
@@ -108,7 +114,7 @@ void write_test_file(const fs::path& file) {
   EXPECT_EQ(w.frames_written(), kFrames);
   Eigen::MatrixXd table(2, 3);
   table << 1, 2, 3, 4, 5, 6;
-  w.write_table("profile", {"y", "u_x", "phi"}, table);
+  w.write_table("profile", {"y", "u_x", "phi"}, {"d", "P d eta-1", "1"}, table);
 }
 
 void expect_frame(const H5mdFrame& fr, int f) {
@@ -116,6 +122,8 @@ void expect_frame(const H5mdFrame& fr, int f) {
   EXPECT_EQ(fr.time, time_at(f));
   EXPECT_EQ(fr.lx, 6.0);
   EXPECT_EQ(fr.ly, ly_at(f));
+  EXPECT_EQ(fr.tilt, tilt_at(f) - 6.0 * std::round(tilt_at(f) / 6.0));
+  EXPECT_TRUE(fr.periodic_y);
   ASSERT_EQ(fr.position.size(), kN);
   ASSERT_EQ(fr.unwrapped.size(), kN);
   ASSERT_EQ(fr.velocity.size(), kN);
@@ -195,21 +203,24 @@ TEST(H5md, LayoutViaCApi) {
   H5Aclose(da);
   EXPECT_EQ(dimension, 2);
 
+  // H5MD 1.1: box/boundary is a fixed-length string array.
+  const hid_t ba =
+      H5Aopen_by_name(f, "/particles/suspension/box", "boundary", H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(ba, 0);
+  const hid_t bt = H5Aget_type(ba);
+  EXPECT_EQ(H5Tis_variable_str(bt), 0);
+  const std::size_t width = H5Tget_size(bt);
+  std::vector<char> bnd(2 * width + 1, '\0');
+  ASSERT_GE(H5Aread(ba, bt, bnd.data()), 0);
+  EXPECT_STREQ(bnd.data(), "periodic");
+  EXPECT_STREQ(bnd.data() + width, "periodic");
+  H5Tclose(bt);
+  H5Aclose(ba);
+
   // Variable-length UTF-8 string attributes: HDF5 has no ASCII<->UTF-8 conversion.
   const hid_t st = H5Tcopy(H5T_C_S1);
   H5Tset_size(st, H5T_VARIABLE);
   H5Tset_cset(st, H5T_CSET_UTF8);
-  char* bnd[2] = {nullptr, nullptr};
-  const hid_t ba =
-      H5Aopen_by_name(f, "/particles/suspension/box", "boundary", H5P_DEFAULT, H5P_DEFAULT);
-  ASSERT_GE(ba, 0);
-  ASSERT_GE(H5Aread(ba, st, bnd), 0);
-  EXPECT_STREQ(bnd[0], "periodic");
-  EXPECT_STREQ(bnd[1], "periodic");
-  H5free_memory(bnd[0]);
-  H5free_memory(bnd[1]);
-  H5Aclose(ba);
-
   char* config = nullptr;
   const hid_t ca = H5Aopen_by_name(f, "/parameters", "config", H5P_DEFAULT, H5P_DEFAULT);
   ASSERT_GE(ca, 0);
@@ -232,16 +243,14 @@ TEST(H5md, LayoutViaCApi) {
   H5Sclose(sp);
   H5Dclose(ds);
 
-  // Table written row-major: element (1, 2) of [[1,2,3],[4,5,6]] is 6.
-  double table[6] = {};
-  const hid_t ts = H5Dopen2(f, "/observables/profile/value", H5P_DEFAULT);
+  // A table: one time-independent element per column.
+  double column[2] = {};
+  const hid_t ts = H5Dopen2(f, "/observables/profile/phi", H5P_DEFAULT);
   ASSERT_GE(ts, 0);
-  ASSERT_GE(H5Dread(ts, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, table), 0);
+  ASSERT_GE(H5Dread(ts, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, column), 0);
   H5Dclose(ts);
-  EXPECT_EQ(table[0], 1.0);
-  EXPECT_EQ(table[2], 3.0);
-  EXPECT_EQ(table[3], 4.0);
-  EXPECT_EQ(table[5], 6.0);
+  EXPECT_EQ(column[0], 3.0);
+  EXPECT_EQ(column[1], 6.0);
 
   H5Fclose(f);
 }
@@ -283,6 +292,339 @@ TEST(H5md, MissingFileThrowsNamingPath) {
       EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
     }
   }
+}
+
+haddr_t address(hid_t f, const std::string& name) {
+  H5O_info_t info{};
+  EXPECT_GE(H5Oget_info_by_name2(f, name.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT), 0) << name;
+  return info.addr;
+}
+
+std::string unit_of(hid_t f, const std::string& name) {
+  if (H5Aexists_by_name(f, name.c_str(), "unit", H5P_DEFAULT) <= 0) return "<none>";
+  const hid_t a = H5Aopen_by_name(f, name.c_str(), "unit", H5P_DEFAULT, H5P_DEFAULT);
+  const hid_t t = H5Tcopy(H5T_C_S1);
+  H5Tset_size(t, H5T_VARIABLE);
+  H5Tset_cset(t, H5T_CSET_ASCII);
+  char* u = nullptr;
+  EXPECT_GE(H5Aread(a, t, &u), 0) << name;
+  std::string out = u != nullptr ? u : "";
+  H5free_memory(u);
+  H5Tclose(t);
+  H5Aclose(a);
+  return out;
+}
+
+const std::string kG = "/particles/suspension/";
+
+TEST(H5md, BoxIsATriclinicMatrixAndStepTimeAreHardLinks) {
+  TempDir dir;
+  const fs::path file = dir.path() / "traj.h5";
+  write_test_file(file);
+  const hid_t f = H5Fopen(file.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+
+  const hid_t ds = H5Dopen2(f, (kG + "box/edges/value").c_str(), H5P_DEFAULT);
+  const hid_t sp = H5Dget_space(ds);
+  hsize_t dims[3] = {};
+  ASSERT_EQ(H5Sget_simple_extent_dims(sp, dims, nullptr), 3);
+  EXPECT_EQ(dims[0], 3u);
+  EXPECT_EQ(dims[1], 2u);
+  EXPECT_EQ(dims[2], 2u);
+  double edges[3][2][2] = {};
+  ASSERT_GE(H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, edges), 0);
+  H5Sclose(sp);
+  H5Dclose(ds);
+  const double reduced[3] = {1.0, 2.0, -3.0};
+  for (int k = 0; k < kFrames; ++k) {
+    EXPECT_EQ(edges[k][0][0], 6.0);
+    EXPECT_EQ(edges[k][0][1], 0.0);
+    EXPECT_EQ(edges[k][1][0], reduced[k]);
+    EXPECT_EQ(edges[k][1][1], ly_at(k));
+  }
+
+  const haddr_t step = address(f, kG + "position/step");
+  const haddr_t time = address(f, kG + "position/time");
+  EXPECT_NE(step, time);
+  for (const std::string& e :
+       {kG + "box/edges", kG + "velocity", kG + "angular_velocity", kG + "image",
+        kG + "unwrapped_position", std::string("/observables/stress_xy"),
+        std::string("/observables/energy")}) {
+    EXPECT_EQ(address(f, e + "/step"), step) << e;
+    EXPECT_EQ(address(f, e + "/time"), time) << e;
+  }
+
+  // image: position + image . edges lands within half a cell of the unwrapped position.
+  std::int32_t image[kFrames][kN][2] = {};
+  const hid_t is = H5Dopen2(f, (kG + "image/value").c_str(), H5P_DEFAULT);
+  ASSERT_GE(H5Dread(is, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, image), 0);
+  H5Dclose(is);
+  for (int k = 0; k < kFrames; ++k) {
+    for (std::size_t i = 0; i < kN; ++i) {
+      const Vec2 r =
+          pos(k, i) + image[k][i][0] * Vec2(6.0, 0.0) + image[k][i][1] * Vec2(reduced[k], ly_at(k));
+      EXPECT_LE(std::abs(r.y() - unw(k, i).y()), 0.5 * ly_at(k)) << k << " " << i;
+      EXPECT_LE(std::abs(r.x() - unw(k, i).x()), 3.0) << k << " " << i;
+    }
+  }
+  H5Fclose(f);
+}
+
+TEST(H5md, EveryElementHasAUnitAndTheCodesNameThemselves) {
+  TempDir dir;
+  const fs::path file = dir.path() / "traj.h5";
+  write_test_file(file);
+  const hid_t f = H5Fopen(file.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const std::vector<std::pair<std::string, std::string>> want = {
+      {kG + "position/value", "d"},
+      {kG + "position/time", "eta P-1"},
+      {kG + "box/edges/value", "d"},
+      {kG + "velocity/value", "P d eta-1"},
+      {kG + "angular_velocity/value", "P eta-1"},
+      {kG + "image/value", "1"},
+      {kG + "unwrapped_position/value", "d"},
+      {kG + "diameter", "d"},
+      {kG + "species", "1"},
+      {kG + "motion", "1"},
+      {"/observables/stress_xy/value", "1"},
+      {"/observables/profile/y", "d"},
+      {"/observables/profile/u_x", "P d eta-1"},
+  };
+  for (const auto& [name, unit] : want) EXPECT_EQ(unit_of(f, name), unit) << name;
+
+  int version[2] = {};
+  const hid_t va = H5Aopen_by_name(f, "/h5md/modules/units", "version", H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(va, 0);
+  ASSERT_GE(H5Aread(va, H5T_NATIVE_INT, version), 0);
+  H5Aclose(va);
+  EXPECT_EQ(version[0], 1);
+  EXPECT_EQ(version[1], 0);
+
+  const hid_t motion = H5Dopen2(f, (kG + "motion").c_str(), H5P_DEFAULT);
+  const hid_t type = H5Dget_type(motion);
+  ASSERT_EQ(H5Tget_class(type), H5T_ENUM);
+  char name[32] = {};
+  const std::int8_t code = 2;
+  ASSERT_GE(H5Tenum_nameof(type, &code, name, sizeof name), 0);
+  EXPECT_STREQ(name, "floating_wall");
+  H5Tclose(type);
+  H5Dclose(motion);
+  H5Fclose(f);
+}
+
+ContactNetwork network_at(int f) {
+  ContactNetwork c;
+  for (int k = 0; k < (f == 1 ? 0 : 2 + f); ++k) {
+    c.pairs.push_back({k, (k + 1 + f) % static_cast<int>(kN)});
+    c.normal_force.push_back(0.5 * k + f);
+    c.tangential_force.push_back(-0.25 * k);
+    c.sliding.push_back(k % 2);
+  }
+  return c;
+}
+
+void write_contact_frames(H5mdWriter& w, int from, int to) {
+  std::vector<Vec2> p(kN, Vec2::Zero());
+  std::vector<Vec3> v(kN, Vec3::Zero());
+  for (int f = from; f < to; ++f) {
+    const ContactNetwork c = network_at(f);
+    FrameData fd;
+    fd.step = step_at(f);
+    fd.time = time_at(f);
+    fd.lx = 6;
+    fd.ly = 8;
+    fd.position = &p;
+    fd.velocity = &v;
+    fd.contacts = &c;
+    fd.observables = {0.0, 0.0};
+    w.write_frame(fd);
+  }
+}
+
+void expect_network(const ContactNetwork& got, int f) {
+  const ContactNetwork want = network_at(f);
+  EXPECT_EQ(got.pairs, want.pairs) << "frame " << f;
+  EXPECT_EQ(got.normal_force, want.normal_force) << "frame " << f;
+  EXPECT_EQ(got.tangential_force, want.tangential_force) << "frame " << f;
+  EXPECT_EQ(got.sliding, want.sliding) << "frame " << f;
+}
+
+TEST(H5md, ContactNetworkRoundTripAndResume) {
+  TempDir dir;
+  const fs::path file = dir.path() / "traj.h5";
+  TrajectoryLayout layout = make_layout();
+  layout.write_contacts = true;
+  {
+    H5mdWriter w(file, layout);
+    write_contact_frames(w, 0, kFrames);
+    FrameData bad;
+    std::vector<Vec2> p(kN, Vec2::Zero());
+    std::vector<Vec3> v(kN, Vec3::Zero());
+    bad.position = &p;
+    bad.velocity = &v;
+    bad.observables = {0.0, 0.0};
+    EXPECT_THROW(w.write_frame(bad), std::runtime_error);  // no network
+  }
+  for (int f = 0; f < kFrames; ++f) expect_network(read_h5md_contacts(file, f), f);
+  {
+    // Back to the first two frames, then a different third one.
+    H5mdWriter w = H5mdWriter::resume(file, layout, 2);
+    write_contact_frames(w, 0, 1);
+  }
+  EXPECT_EQ(count_h5md_frames(file), kFrames);
+  expect_network(read_h5md_contacts(file, 0), 0);
+  expect_network(read_h5md_contacts(file, 1), 1);
+  expect_network(read_h5md_contacts(file, 2), 0);
+
+  const hid_t f = H5Fopen(file.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  EXPECT_EQ(address(f, "/connectivity/contacts/step"), address(f, kG + "position/step"));
+  hobj_ref_t ref{};
+  const hid_t a =
+      H5Aopen_by_name(f, "/connectivity/contacts", "particles_group", H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(a, 0);
+  ASSERT_GE(H5Aread(a, H5T_STD_REF_OBJ, &ref), 0);
+  H5Aclose(a);
+  const hid_t g = H5Rdereference2(f, H5P_DEFAULT, H5R_OBJECT, &ref);
+  ASSERT_GE(g, 0);
+  char name[64] = {};
+  H5Iget_name(g, name, sizeof name);
+  EXPECT_STREQ(name, "/particles/suspension");
+  H5Oclose(g);
+  H5Fclose(f);
+}
+
+// A minimal file as another writer might make it: group "all", a time-independent 3D
+// triclinic box, fixed step/time storage, float32 positions, integer species.
+void write_foreign_file(const fs::path& file) {
+  const hid_t f = H5Fcreate(file.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const auto group = [&](const char* name) {
+    H5Gclose(H5Gcreate2(f, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  };
+  group("/h5md");
+  group("/particles");
+  group("/particles/all");
+  group("/particles/all/box");
+  group("/particles/all/position");
+  const hid_t box = H5Gopen2(f, "/particles/all/box", H5P_DEFAULT);
+  const hid_t scalar = H5Screate(H5S_SCALAR);
+  const int three = 3;
+  hid_t a = H5Acreate2(box, "dimension", H5T_STD_I32LE, scalar, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, H5T_NATIVE_INT, &three);
+  H5Aclose(a);
+  const hid_t vl = H5Tcopy(H5T_C_S1);
+  H5Tset_size(vl, H5T_VARIABLE);
+  const hsize_t three_dims[1] = {3};
+  const hid_t s3 = H5Screate_simple(1, three_dims, nullptr);
+  const char* bnd[3] = {"periodic", "periodic", "periodic"};
+  a = H5Acreate2(box, "boundary", vl, s3, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, vl, bnd);
+  H5Aclose(a);
+  H5Sclose(s3);
+  H5Tclose(vl);
+  H5Gclose(box);
+  const auto dataset = [&](const char* name, hid_t type, std::vector<hsize_t> dims,
+                           const void* data, hid_t mem) {
+    const hid_t sp = dims.empty()
+                         ? H5Screate(H5S_SCALAR)
+                         : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    const hid_t ds = H5Dcreate2(f, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(ds, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Sclose(sp);
+    return ds;
+  };
+  const double edges[3][3] = {{5, 0, 0}, {1.5, 4, 0}, {0, 0, 9}};
+  H5Dclose(dataset("/particles/all/box/edges", H5T_IEEE_F64LE, {3, 3}, edges, H5T_NATIVE_DOUBLE));
+  const long step = 10, offset = 100;
+  const hid_t st =
+      dataset("/particles/all/position/step", H5T_STD_I64LE, {}, &step, H5T_NATIVE_LONG);
+  a = H5Acreate2(st, "offset", H5T_STD_I64LE, scalar, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, H5T_NATIVE_LONG, &offset);
+  H5Aclose(a);
+  H5Dclose(st);
+  const double dt = 0.5;
+  H5Dclose(dataset("/particles/all/position/time", H5T_IEEE_F64LE, {}, &dt, H5T_NATIVE_DOUBLE));
+  const float xyz[2][2][3] = {{{1, 2, 0}, {3, 1, 0}}, {{1.5f, 2.5f, 0}, {3.5f, 0.5f, 0}}};
+  H5Dclose(
+      dataset("/particles/all/position/value", H5T_IEEE_F32LE, {2, 2, 3}, xyz, H5T_NATIVE_FLOAT));
+  const int species[2] = {0, 1};
+  H5Dclose(dataset("/particles/all/species", H5T_STD_I32LE, {2}, species, H5T_NATIVE_INT));
+  H5Sclose(scalar);
+  H5Fclose(f);
+}
+
+TEST(H5md, ReadsAnotherWritersFileQuietly) {
+  TempDir dir;
+  const fs::path file = dir.path() / "foreign.h5";
+  write_foreign_file(file);
+  testing::internal::CaptureStderr();
+  const long frames = count_h5md_frames(file);
+  const H5mdFrame fr = read_h5md_frame(file, 1);
+  const std::string noise = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(noise, "");
+  EXPECT_EQ(frames, 2);
+  EXPECT_EQ(fr.step, 110);
+  EXPECT_EQ(fr.time, 0.5);
+  EXPECT_EQ(fr.lx, 5.0);
+  EXPECT_EQ(fr.ly, 4.0);
+  EXPECT_EQ(fr.tilt, 1.5);
+  ASSERT_EQ(fr.position.size(), 2u);
+  EXPECT_EQ(fr.position[1], Vec2(3.5, 0.5));
+  EXPECT_EQ(fr.species, (std::vector<int>{0, 1}));
+  EXPECT_TRUE(fr.motion.empty());
+  EXPECT_TRUE(read_h5md_contacts(file).pairs.empty());
+}
+
+// The layout before issue 17: a cuboid box vector per frame with its own step and time.
+TEST(H5md, ReadsTheOldCuboidLayout) {
+  TempDir dir;
+  const fs::path file = dir.path() / "old.h5";
+  const hid_t f = H5Fcreate(file.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  for (const char* g : {"/particles", "/particles/suspension", "/particles/suspension/box",
+                        "/particles/suspension/box/edges", "/particles/suspension/position"})
+    H5Gclose(H5Gcreate2(f, g, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  const hid_t box = H5Gopen2(f, "/particles/suspension/box", H5P_DEFAULT);
+  const hid_t vl = H5Tcopy(H5T_C_S1);
+  H5Tset_size(vl, H5T_VARIABLE);
+  H5Tset_cset(vl, H5T_CSET_UTF8);
+  const hsize_t two[1] = {2};
+  const hid_t s2 = H5Screate_simple(1, two, nullptr);
+  const char* bnd[2] = {"periodic", "periodic"};
+  const hid_t a = H5Acreate2(box, "boundary", vl, s2, H5P_DEFAULT, H5P_DEFAULT);
+  H5Awrite(a, vl, bnd);
+  H5Aclose(a);
+  H5Sclose(s2);
+  H5Tclose(vl);
+  H5Gclose(box);
+  const auto dataset = [&](const char* name, hid_t type, std::vector<hsize_t> dims,
+                           const void* data, hid_t mem) {
+    const hid_t sp = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+    H5Dclose(H5Dcreate2(f, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    const hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    H5Dwrite(ds, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Dclose(ds);
+    H5Sclose(sp);
+  };
+  const std::int64_t step[1] = {40};
+  const double time[1] = {2.0}, edges[1][2] = {{6.0, 7.0}}, xy[1][1][2] = {{{1.0, 2.0}}};
+  const int motion[1] = {0};
+  for (const char* e : {"box/edges", "position"}) {
+    dataset((kG + e + "/step").c_str(), H5T_STD_I64LE, {1}, step, H5T_NATIVE_INT64);
+    dataset((kG + e + "/time").c_str(), H5T_IEEE_F64LE, {1}, time, H5T_NATIVE_DOUBLE);
+  }
+  dataset((kG + "box/edges/value").c_str(), H5T_IEEE_F64LE, {1, 2}, edges, H5T_NATIVE_DOUBLE);
+  dataset((kG + "position/value").c_str(), H5T_IEEE_F64LE, {1, 1, 2}, xy, H5T_NATIVE_DOUBLE);
+  dataset((kG + "motion").c_str(), H5T_STD_I32LE, {1}, motion, H5T_NATIVE_INT);
+  H5Fclose(f);
+
+  const H5mdFrame fr = read_h5md_frame(file);
+  EXPECT_EQ(fr.step, 40);
+  EXPECT_EQ(fr.lx, 6.0);
+  EXPECT_EQ(fr.ly, 7.0);
+  EXPECT_EQ(fr.tilt, 0.0);
+  EXPECT_EQ(fr.position[0], Vec2(1.0, 2.0));
+  EXPECT_EQ(fr.motion, (std::vector<int>{0}));
 }
 
 TEST(PositionTable, ReadsWithCommentsAndBlankLines) {

@@ -2,6 +2,7 @@
 // H5MD 1.1 trajectory output/input (HDF5 C API kept out of this header) and the plain-text
 // position table reader. All errors are std::runtime_error naming the file and the object.
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <memory>
@@ -12,6 +13,17 @@
 
 namespace sheardiff {
 
+// Per-frame contact network: contact k joins particles pairs[k] (indices into the particle
+// group, i < j not implied). Forces are those of the contact springs at the frame: the normal
+// force kn * overlap (repulsive > 0) and the tangential force on j along t = z x n (n from i to
+// j), in P d^2; sliding: 1 at the Coulomb limit, else 0.
+struct ContactNetwork {
+  std::vector<std::array<int, 2>> pairs;
+  std::vector<double> normal_force;
+  std::vector<double> tangential_force;
+  std::vector<int> sliding;
+};
+
 struct TrajectoryLayout {
   std::size_t n_particles = 0;           // all particles, mobile first then wall particles
   std::vector<int> species;              // 0 small, 1 large (size n_particles)
@@ -20,7 +32,13 @@ struct TrajectoryLayout {
   double lx = 1, ly = 1;                 // initial box edges
   bool lees_edwards = false;             // y boundary: "periodic" if true, else "none"
   bool write_velocity = true;            // write velocity (u_x,u_y) and angular_velocity (omega_z)
+  bool write_contacts = false;           // write /connectivity/contacts every frame
   std::vector<std::string> observables;  // names of scalar observables written per frame
+  // H5MD unit strings in the project's units (docs/trajectory.md), same order as observables;
+  // empty: every observable is dimensionless ("1").
+  std::vector<std::string> observable_units;
+  // /h5md/author@name; empty: $SHEARDIFF_AUTHOR, else the account's name, else "unknown"
+  std::string author;
   std::string creator_version;           // e.g. "0.1.0"
   std::string config_toml;               // resolved config text, stored as /parameters@config
 };
@@ -28,10 +46,12 @@ struct TrajectoryLayout {
 struct FrameData {
   long step = 0;
   double time = 0;
-  double lx = 1, ly = 1;                         // box edges at this frame
+  double lx = 1, ly = 1;  // box edges at this frame (ly unused where y is not periodic)
+  double tilt = 0;        // Lees-Edwards shift of the image at +ly (any multiple of lx added)
   const std::vector<Vec2>* position = nullptr;   // wrapped positions, required
   const std::vector<Vec2>* unwrapped = nullptr;  // optional; only honoured if given at frame 0
   const std::vector<Vec3>* velocity = nullptr;   // (u_x,u_y,omega), required if write_velocity
+  const ContactNetwork* contacts = nullptr;      // required if write_contacts
   std::vector<double> observables;               // same order as layout.observables
 };
 
@@ -52,10 +72,10 @@ class H5mdWriter {
 
   // Appends one row to every time-dependent dataset. Validates all inputs before writing.
   void write_frame(const FrameData& frame);
-  // Time-independent table /observables/<name>/value (rows, cols) with string-array
-  // attribute "columns" on the value dataset. The name must not already exist.
+  // Time-independent table: one time-independent element /observables/<name>/<column> of
+  // shape (rows) per column, each with its H5MD unit string. The name must not already exist.
   void write_table(const std::string& name, const std::vector<std::string>& columns,
-                   const Eigen::MatrixXd& values);
+                   const std::vector<std::string>& units, const Eigen::MatrixXd& values);
   void flush();
   long frames_written() const;
 
@@ -65,10 +85,14 @@ class H5mdWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+// One frame of an H5MD particle group: ours, or any writer's with a 2D box (or a 3D one,
+// of which x and y are taken). Read from the group "suspension", else "all", else the only one.
 struct H5mdFrame {
   long step = 0;
   double time = 0;
   double lx = 0, ly = 0;
+  double tilt = 0;         // x component of the second edge vector (0 for a cuboid box)
+  bool periodic_y = true;  // box/boundary[1]; ly is a placeholder where it is "none"
   std::vector<Vec2> position;
   std::vector<Vec2> unwrapped;  // empty if the file has no unwrapped_position
   std::vector<Vec3> velocity;   // empty if the file has no velocity
@@ -80,6 +104,8 @@ struct H5mdFrame {
 // frame = -1 means the last frame; otherwise 0-based; throws if out of range.
 H5mdFrame read_h5md_frame(const std::filesystem::path& file, long frame = -1);
 long count_h5md_frames(const std::filesystem::path& file);
+// The contact network of a frame (frame = -1: the last); empty if none was written.
+ContactNetwork read_h5md_contacts(const std::filesystem::path& file, long frame = -1);
 
 // Scalar observable time series; columns truncated to the shortest of step/time/value
 // so a file cut short by a crash still reads.

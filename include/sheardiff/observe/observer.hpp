@@ -26,6 +26,10 @@ class Observer {
   virtual ~Observer() = default;
   // Scalar observables written to every trajectory frame (names fixed for the run).
   virtual std::vector<std::string> frame_names() const { return {}; }
+  // Their H5MD unit strings in the project's units (docs/trajectory.md), same order.
+  virtual std::vector<std::string> frame_units() const {
+    return std::vector<std::string>(frame_names().size(), "1");
+  }
   // Called on frame steps; appends one value per frame_names() entry.
   virtual void on_frame(const StepView&, std::vector<double>& values) { (void)values; }
   // Called after every step (time averages).
@@ -48,6 +52,7 @@ class RheologyObserver final : public Observer {
  public:
   explicit RheologyObserver(double transient_strain) : transient_(transient_strain) {}
   std::vector<std::string> frame_names() const override;
+  std::vector<std::string> frame_units() const override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void on_step(const StepView& v) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;

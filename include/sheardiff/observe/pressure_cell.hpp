@@ -48,6 +48,7 @@ class PressureCellObserver final : public Observer {
  public:
   explicit PressureCellObserver(const Config& cfg);
   std::vector<std::string> frame_names() const override;
+  std::vector<std::string> frame_units() const override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void on_step(const StepView& v) override;
   bool done(const Dynamics& d) const override;

@@ -1,5 +1,6 @@
 #pragma once
 #include "sheardiff/integrator/dynamics.hpp"
+#include "sheardiff/io/h5md.hpp"
 
 namespace sheardiff {
 
@@ -25,5 +26,8 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
                             const Velocities& v, double lz);
 // Weighted mean of two samples (stresses, wall forces, overlaps); the contact count of `a`.
 StressSample average(const StressSample& a, const StressSample& b);
+
+// The contacts open at the current configuration with their spring forces (ContactNetwork).
+ContactNetwork contact_network(const Dynamics& d);
 
 }  // namespace sheardiff

@@ -17,6 +17,7 @@ struct Packing {
   std::vector<double> radius;
   std::vector<int> species;
   double lx = 0, ly = 0;
+  double tilt = 0;  // x shift of the image at +ly (a Lees-Edwards cell read from a file)
 };
 
 // Random non-overlapping discs in a periodic lx x ly cell at area fraction phi. Random

@@ -1,0 +1,219 @@
+#!/usr/bin/python3
+"""ctest: sheardiff's trajectories read by code other than sheardiff's own.
+
+Runs a small simple-shear and a small pressure-cell run (contact network on), then
+1. the independent H5MD 1.1 checker (tests/h5md/h5md_check.py, units required) must pass on
+   both, and must fail on a copy whose box/edges step is a copy rather than a hard link;
+2. the GSD export (tools/h5md_to_gsd.py) read back with the gsd package: the box of every frame
+   must be the H5MD one (Lx, Ly, tilt = xy Ly), and the minimum-image overlaps found under that
+   box must be the simulation's (largest overlap at most the run's health limit, every pair of
+   /connectivity/contacts within contact distance), while the same positions under the box
+   without its tilt show the false overlaps across the y edges that the tilt removes.
+
+    outside_readers.py --bin build/sheardiff --root . --work DIR
+"""
+import argparse
+import pathlib
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from h5md_check import check_file  # noqa: E402
+
+SIMPLE = """[scene]
+type = "simple_shear"
+[particles]
+N = 100
+phi_init = 0.78
+[flow]
+J = 1e-2
+[run]
+strain = 0.5
+seed = 3
+transient_strain = 0.1
+[analysis]
+diffusion = false
+[output]
+frame_strain = 0.05
+contacts = true
+author = "Outside Reader Test"
+"""
+PRESSURE = """[scene]
+type = "pressure_shear"
+[particles]
+N = 80
+phi_init = 0.6
+[flow]
+J = 1e-2
+[run]
+strain = 2.0
+seed = 2
+[analysis]
+diffusion = false
+[steady]
+window = 0.3
+measure_strain = 0.3
+[output]
+frame_strain = 0.05
+contacts = true
+"""
+GENUINE = 0.1  # d: health.max_overlap, the largest overlap a run may have
+failures = []
+
+
+def expect(ok, what):
+    print(("ok    " if ok else "FAIL  ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def min_image_overlaps(pos, diam, lx, ly, xy_len, periodic_y=True):
+    """Pairs (i, j, overlap) overlapping under the box with edge vectors (lx, 0), (xy_len, ly)."""
+    d = pos[None, :, :] - pos[:, None, :]
+    if periodic_y:
+        ny = np.round(d[..., 1] / ly)
+        d[..., 0] -= ny * xy_len
+        d[..., 1] -= ny * ly
+    d[..., 0] -= lx * np.round(d[..., 0] / lx)
+    r = np.hypot(d[..., 0], d[..., 1])
+    s = 0.5 * (diam[:, None] + diam[None, :])
+    ov = s - r
+    i, j = np.nonzero(np.triu(ov > 0, 1))
+    return i, j, ov[i, j], r, s
+
+
+def run(binary, work, name, text):
+    cfg = work / f"{name}.toml"
+    cfg.write_text(text)
+    out = work / name
+    p = subprocess.run([binary, "run", str(cfg), "--out", str(out)], capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit(f"{name}: sheardiff run failed ({p.returncode}):\n{p.stderr}")
+    return out / "trajectory.h5"
+
+
+def check_conformance(traj, work):
+    errors = check_file(traj, require_units=True)
+    for e in errors:
+        print("      " + e)
+    expect(not errors, f"{traj.parent.name}: independent H5MD 1.1 checker, units required")
+    broken = work / f"{traj.parent.name}_unlinked.h5"
+    shutil.copy(traj, broken)
+    with h5py.File(broken, "r+") as f:
+        e = f["particles/suspension/box/edges"]
+        step = e["step"][()]
+        del e["step"]
+        e["step"] = step
+    errors = check_file(broken, require_units=True)
+    expect(any("hard link" in x for x in errors), f"{traj.parent.name}: the checker catches an unlinked step")
+
+
+def check_gsd(root, traj, periodic_y):
+    import gsd.hoomd
+
+    name = traj.parent.name
+    out = traj.with_suffix(".gsd")
+    subprocess.run([sys.executable, str(root / "tools" / "h5md_to_gsd.py"), str(traj), "--out", str(out)],
+                   check=True, capture_output=True)
+    with h5py.File(traj, "r") as f:
+        g = f["particles/suspension"]
+        edges = g["box/edges/value"][()]
+        diam = g["diameter"][()]
+        pairs = f["connectivity/contacts/value"][()]
+        max_overlap = f["observables/max_overlap/value"][()]
+    try:
+        traj_gsd = gsd.hoomd.open(name=str(out), mode="r")
+    except ValueError:
+        traj_gsd = gsd.hoomd.open(name=str(out), mode="rb")
+    box_ok, worst, worst_free, false_pairs, pair_gap = True, 0.0, 0.0, 0, 0.0
+    with traj_gsd as t:
+        expect(len(t) == len(edges), f"{name}: GSD holds all {len(edges)} frames")
+        for k, fr in enumerate(t):
+            lx, ly, lz, xy = (float(x) for x in fr.configuration.box[:4])
+            if periodic_y:
+                box_ok &= bool(np.isclose(lx, edges[k, 0, 0]) and np.isclose(ly, edges[k, 1, 1])
+                               and np.isclose(xy * ly, edges[k, 1, 0], atol=1e-5) and lz == 0)
+            else:
+                box_ok &= bool(np.isclose(lx, edges[k, 0, 0]) and xy == 0 and lz == 0)
+            box_ok &= fr.configuration.dimensions == 2
+            pos = fr.particles.position[:, :2].astype(np.float64)
+            i, j, ov, r, s = min_image_overlaps(pos, diam, lx, ly, xy * ly)
+            # The discs of one rough wall overlap by construction and are no contacts.
+            wall = np.isin(fr.particles.typeid, [fr.particles.types.index("fixed_wall"),
+                                                 fr.particles.types.index("floating_wall")])
+            ov = ov[~(wall[i] & wall[j])]
+            worst = max(worst, ov.max(initial=0.0))
+            expect_max = max_overlap[k]
+            if ov.size and ov.max() > expect_max + 1e-3:
+                print(f"      frame {k}: overlap {ov.max():.4f} d above the run's max_overlap {expect_max:.4f} d")
+                box_ok = False
+            used = pairs[k][pairs[k, :, 0] >= 0]
+            if used.size:
+                pair_gap = max(pair_gap, float(np.max(r[used[:, 0], used[:, 1]] - s[used[:, 0], used[:, 1]])))
+            if periodic_y:
+                _, _, ov0, _, _ = min_image_overlaps(pos, diam, lx, ly, 0.0)
+                false_pairs = max(false_pairs, int(np.sum(ov0 > GENUINE)))
+                worst_free = max(worst_free, ov0.max(initial=0.0))
+    expect(box_ok, f"{name}: gsd reads the H5MD box (Lx, Ly, xy Ly = tilt) and the run's overlaps in every frame")
+    print(f"      largest overlap under the GSD box: {worst:.4f} d (run's max_overlap {max_overlap.max():.4f} d)")
+    expect(worst <= GENUINE, f"{name}: no overlap above {GENUINE} d under the GSD box")
+    expect(pair_gap <= 1e-2, f"{name}: every /connectivity/contacts pair touches under the box (widest gap {pair_gap:.2e} d)")
+    if periodic_y:
+        print(f"      without the tilt: {false_pairs} pairs overlapping by more than {GENUINE} d, up to {worst_free:.2f} d")
+        expect(false_pairs > 0, f"{name}: the box without its tilt shows false overlaps (the check has teeth)")
+
+
+def check_plot_tools(root, work, runs):
+    """The plot tools draw both runs (no analysis.h5 in either) and end with one line, not a
+    traceback, when their input is missing."""
+    for tool, png in (("plot_run.py", "timeseries.png"), ("snapshot.py", "snapshot.png")):
+        for run_dir in runs:
+            p = subprocess.run([sys.executable, str(root / "tools" / tool), str(run_dir)],
+                               capture_output=True, text=True)
+            expect(p.returncode == 0 and (run_dir / png).is_file(),
+                   f"{tool} draws {run_dir.name}/{png}" + (f": {p.stderr.strip()}" if p.returncode else ""))
+        p = subprocess.run([sys.executable, str(root / "tools" / tool), str(work / "missing")],
+                           capture_output=True, text=True)
+        lines = p.stderr.strip().splitlines()
+        expect(p.returncode != 0 and len(lines) == 1 and "Traceback" not in p.stderr,
+               f"{tool} on a missing run: one line ({lines[:1]})")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--root", required=True, type=pathlib.Path)
+    ap.add_argument("--work", required=True, type=pathlib.Path)
+    args = ap.parse_args()
+    shutil.rmtree(args.work, ignore_errors=True)
+    args.work.mkdir(parents=True)
+    simple = run(args.bin, args.work, "simple_shear", SIMPLE)
+    pressure = run(args.bin, args.work, "pressure_cell", PRESSURE)
+    for traj in (simple, pressure):
+        check_conformance(traj, args.work)
+    with h5py.File(simple, "r") as f:
+        author = f["h5md/author"].attrs["name"]
+        expect((author.decode() if isinstance(author, bytes) else author) == "Outside Reader Test",
+               "output.author reaches /h5md/author")
+    with h5py.File(pressure, "r") as f:
+        expect("profiles" in f["observables"] and "unit" in f["observables/profiles/phi"].attrs,
+               "pressure cell: /observables/profiles written, one element per column with a unit")
+    try:
+        import gsd.hoomd  # noqa: F401
+    except ImportError:
+        expect(False, "the gsd package (python3-gsd, tools/setup.sh) is installed")
+    else:
+        check_gsd(args.root, simple, True)
+        check_gsd(args.root, pressure, False)
+    check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
+    print(f"{len(failures)} failed")
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
