@@ -162,6 +162,13 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("contact.mu", &C::contact, &C::Contact::mu, 0.0, 10.0, false, "",
                      "Coulomb friction coefficient (0 = frictionless, no tangential springs)."));
     s.push_back(choice(
+        "contact.stiffness", {"uniform", "mean_radius"},
+        "Per-pair stiffness: `uniform` (every pair kn, kt) or `mean_radius` (LF_DEM's "
+        "convention: kn, kt times (a_i + a_j) / d, so 1.2x for small-large and 1.4x for "
+        "large-large pairs at size_ratio 1.4).",
+        [](const C& c) { return Value{c.contact.stiffness}; },
+        [](C& c, const Value& v) { c.contact.stiffness = std::get<std::string>(v); }));
+    s.push_back(choice(
         "integrator.type", {"implicit", "euler", "heun"},
         "Spring integration: `implicit` (linearly implicit springs, dt set by accuracy), "
         "`euler` or `heun` (explicit springs, dt capped by the contact stability limit).",

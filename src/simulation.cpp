@@ -33,7 +33,8 @@ std::optional<Lubrication> lubrication_of(const Config& cfg) {
 
 FrictionalContact contact_of(const Config& cfg) {
   const double kn = cfg.contact.ktilde;
-  return FrictionalContact{kn, cfg.contact.kt_ratio * kn, cfg.contact.mu};
+  return FrictionalContact{kn, cfg.contact.kt_ratio * kn, cfg.contact.mu,
+                           cfg.contact.stiffness == "mean_radius"};
 }
 
 }  // namespace

@@ -40,6 +40,7 @@ struct Config {
     double ktilde = 1e4;
     double kt_ratio = 0.5;
     double mu = 0.5;
+    std::string stiffness = "uniform";  // or "mean_radius" (kn, kt x (a_i + a_j) / d)
   } contact;
   struct Integrator {
     IntegratorType type = IntegratorType::Implicit;

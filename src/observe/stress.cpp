@@ -75,8 +75,8 @@ ContactNetwork contact_network(const Dynamics& d) {
     const Vec2 rij = p.position[pr.j] + d.box().image_shift(pr.kx, pr.ky) - p.position[pr.i];
     const PairGeometry g = PairGeometry::make(rij, p.radius[pr.i], p.radius[pr.j]);
     c.pairs.push_back({pr.i, pr.j});
-    c.normal_force.push_back(law.kn * std::max(g.overlap(), 0.0));
-    c.tangential_force.push_back(-law.kt * pr.contact.xi);  // spring force on j along z x n
+    c.normal_force.push_back(law.kn_of(g) * std::max(g.overlap(), 0.0));
+    c.tangential_force.push_back(-law.kt_of(g) * pr.contact.xi);  // spring force on j along z x n
     c.sliding.push_back(pr.contact.sliding ? 1 : 0);
   }
   return c;

@@ -91,11 +91,11 @@ bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box, con
   for (std::size_t k : switched) full = full || p.motion[pairs[k].j] == Motion::FloatingWall;
   if (full) return solve(p, box, flow, pairs, dt_implicit, wall, out);
   const int d = system_.dof();
-  const double kt = dt_implicit * contact_.kt;
   VecX w, dg;
   for (std::size_t k : switched) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
+    const double kt = dt_implicit * contact_.kt_of(term.g);
     const Vec6 w6 = FrictionalContact::slip_mode(term.g);
     // The pair term as a new assembly would make it (stresses read it after the step).
     term.m += kt * w6 * w6.transpose();

@@ -571,3 +571,26 @@ TEST(TwoBodyContact, SlidingSpeedMatchesAnalyticImplicitLargeStep) {
 
 }  // namespace
 }  // namespace sheardiff
+
+namespace sheardiff {
+namespace {
+
+// contact.stiffness = "mean_radius" (LF_DEM's convention): the spring force and stiffness of a
+// pair scale with (a_i + a_j) / d, 1.2 for small-large and 1.4 for large-large pairs, while the
+// Coulomb cap (a ratio of the two stiffnesses) does not move.
+TEST(FrictionalContact, MeanRadiusStiffnessScalesEachPair) {
+  const FrictionalContact uniform{1e4, 5e3, 0.5, false}, scaled{1e4, 5e3, 0.5, true};
+  for (const auto& [ai, aj, factor] : {std::tuple{0.5, 0.5, 1.0}, {0.5, 0.7, 1.2}, {0.7, 0.7, 1.4}}) {
+    const PairGeometry g = PairGeometry::make(Vec2(ai + aj - 0.003, 0.0), ai, aj);
+    const Vec6 fu = uniform.spring_force(g, 1e-4), fs = scaled.spring_force(g, 1e-4);
+    EXPECT_NEAR((fs - factor * fu).norm(), 0.0, 1e-12 * fu.norm());
+    EXPECT_NEAR((scaled.stiffness(g, false) - factor * uniform.stiffness(g, false)).norm(), 0.0,
+                1e-9);
+    double xu = 1.0, xs = 1.0;
+    EXPECT_EQ(uniform.apply_coulomb(g, xu), scaled.apply_coulomb(g, xs));
+    EXPECT_DOUBLE_EQ(xu, xs);
+  }
+}
+
+}  // namespace
+}  // namespace sheardiff

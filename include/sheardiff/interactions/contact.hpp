@@ -16,8 +16,14 @@ struct FrictionalContact {
   double kn = 1e4;
   double kt = 5e3;
   double mu = 0.5;
+  // LF_DEM's convention: each pair's kn and kt scaled by its mean radius over the small one,
+  // (a_i + a_j) / d (1, 1.2, 1.4 for small-small, small-large, large-large at 1 : 1.4).
+  bool scale_with_radius = false;
 
   bool has_friction() const { return mu > 0.0 && kt > 0.0; }
+  double scale(const PairGeometry& g) const { return scale_with_radius ? g.ai + g.aj : 1.0; }
+  double kn_of(const PairGeometry& g) const { return kn * scale(g); }
+  double kt_of(const PairGeometry& g) const { return kt * scale(g); }
 
   // Normal direction in pair space: d(overlap)/dt = normal_mode . U.
   static Vec6 normal_mode(const PairGeometry& g) {
@@ -36,7 +42,7 @@ struct FrictionalContact {
 
   // Spring force and torque on the pair (generalised 6-vector) for overlap and stretch xi.
   Vec6 spring_force(const PairGeometry& g, double xi) const {
-    return -kn * g.overlap() * normal_mode(g) + kt * xi * slip_mode(g);
+    return scale(g) * (-kn * g.overlap() * normal_mode(g) + kt * xi * slip_mode(g));
   }
   // The linearised spring stiffness: the force after a step dt is spring_force - dt K U.
   // A sliding contact has no tangential stiffness (its force is fixed at the Coulomb cap).
@@ -47,12 +53,12 @@ struct FrictionalContact {
       const Vec6 w = slip_mode(g);
       k += kt * w * w.transpose();
     }
-    return k;
+    return scale(g) * k;
   }
   bool at_coulomb_limit(const PairGeometry& g, double xi) const {
     return kt * std::abs(xi) >= mu * kn * g.overlap() * (1.0 - 1e-12);
   }
-  // Coulomb: |kt xi| <= mu kn overlap; returns whether the contact slides.
+  // Coulomb: |kt xi| <= mu kn overlap (the pair's scale cancels); returns whether it slides.
   bool apply_coulomb(const PairGeometry& g, double& xi) const {
     if (!has_friction()) {
       xi = 0.0;
