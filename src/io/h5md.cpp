@@ -12,6 +12,9 @@
 #include <type_traits>
 #include <utility>
 
+#include "sheardiff/io/hdf5_diagnostics.hpp"
+#include "sheardiff/io/io_error.hpp"
+
 namespace sheardiff {
 
 namespace fs = std::filesystem;
@@ -71,8 +74,9 @@ class ErrorPrintGuard {
 };
 
 [[noreturn]] void fail(const fs::path& file, std::string_view object, std::string_view what) {
-  throw std::runtime_error(
-      fmt::format("H5MD file '{}', object '{}': {}", file.string(), object, what));
+  const std::string reason = hdf5_os_reason();
+  throw IoError(fmt::format("H5MD file '{}', object '{}': {}{}{}", file.string(), object, what,
+                            reason.empty() ? "" : ": ", reason));
 }
 
 Handle checked(hid_t id, Closer closer, const fs::path& file, std::string_view object,
@@ -588,8 +592,11 @@ void H5mdWriter::write_table(const std::string& name, const std::vector<std::str
     fail(m.path, group_name,
          fmt::format("{} column names for {} columns", columns.size(), values.cols()));
   }
+  // Replaced, not refused: a run resumed from a checkpoint taken before its end writes its
+  // tables again over those a killed attempt had written.
   if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0) {
-    fail(m.path, group_name, "object already exists");
+    check(H5Ldelete(m.file.get(), group_name.c_str(), H5P_DEFAULT), m.path, group_name,
+          "cannot replace the table");
   }
   Handle group = create_group(m.file.get(), group_name, m.path);
   // HDF5 is row-major, Eigen's default column-major.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/simulation.hpp"
 
 namespace sheardiff {
 namespace {
@@ -410,6 +411,20 @@ TEST(Config, TinyJAndDeltaAreOutOfRange) {
 TEST(Config, SetValueWithALineBreakIsRefused) {
   const std::string e = config_error("", {"flow.J=1e-2\nrun.strain=5"});
   EXPECT_CONTAINS(e, "--set flow.J=1e-2: the value holds a line break");
+}
+
+// The frame catch-up advances as repeated addition does, and ends whatever the spacing.
+TEST(Config, NextOutputStrainEndsForAnySpacing) {
+  double next = 0.02;
+  for (const double strain : {0.0199999999999, 0.05, 0.0601, 0.3}) {
+    double expected = next;
+    while (expected <= strain * (1.0 + 1e-12)) expected += 0.02;
+    next = next_output_strain(next, 0.02, strain);
+    EXPECT_EQ(next, expected) << strain;
+  }
+  EXPECT_GT(next_output_strain(1e-300, 1e-300, 1.0), 1.0);
+  EXPECT_GT(next_output_strain(0.5, 1e-20, 1.0), 1.0);
+  EXPECT_LT(next_output_strain(0.5, 1e-20, 1.0), 1.0 + 1e-11);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 // H5MD 1.1 trajectory output/input (HDF5 C API kept out of this header) and the plain-text
-// position table reader. All errors are std::runtime_error naming the file and the object.
+// position table reader. All errors are IoError (a std::runtime_error) naming the file, the
+// object and, where HDF5 recorded one, the operating system's reason.
 #include <Eigen/Core>
 #include <cstddef>
 #include <filesystem>
@@ -53,7 +54,7 @@ class H5mdWriter {
   // Appends one row to every time-dependent dataset. Validates all inputs before writing.
   void write_frame(const FrameData& frame);
   // Time-independent table /observables/<name>/value (rows, cols) with string-array
-  // attribute "columns" on the value dataset. The name must not already exist.
+  // attribute "columns" on the value dataset; a table of that name is replaced.
   void write_table(const std::string& name, const std::vector<std::string>& columns,
                    const Eigen::MatrixXd& values);
   void flush();
