@@ -272,6 +272,15 @@ int main(int argc, char** argv) {
     if (resume) out_dir = resume_dir;
     using sheardiff::RunMode;
     const RunMode mode = resume ? RunMode::resume : overwrite ? RunMode::overwrite : RunMode::start;
+    // --overwrite deletes DIR/config.toml: it must not be the file the user runs.
+    std::error_code same_ec;
+    if (mode == RunMode::overwrite &&
+        std::filesystem::equivalent(config_path, std::filesystem::path(out_dir) / "config.toml",
+                                    same_ec))
+      throw sheardiff::ConfigError(fmt::format(
+          "{} is the config.toml of the run in {}, which --overwrite deletes: copy it elsewhere "
+          "and run that copy",
+          config_path, out_dir));
     dir.emplace(out_dir, mode != RunMode::resume);
     const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, true);
     const auto flag = [&](const char* key) {

@@ -52,6 +52,10 @@ grep -q "^J = 0.02" fin/config.toml || fail "config.toml is not the new run's"
 [ "$(grep -c '^===' fin/run.log)" = 1 ] || fail "the old run.log survived --overwrite"
 expect 2 "output.trajectory = false: there is no trajectory to analyse" -- analyse fin
 
+# --overwrite would delete the config it is given.
+expect 2 "fin/config.toml is the config.toml of the run in fin, which --overwrite deletes" -- run fin/config.toml --out fin --overwrite
+[ -e fin/config.toml ] || fail "--overwrite deleted the config it was running"
+
 # An interrupted run: forgetting --resume is refused, the checkpoint untouched; --resume goes on.
 "$bin" run run.toml --out int > int.out 2>&1 &
 pid=$!
