@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
@@ -102,13 +101,19 @@ class RunDirectory::OutputTee {
     std::cout.flush();
     std::fflush(stdout);
     std::fflush(stderr);
+    // Both pipes first: a failure must not leave one of fds 1 and 2 redirected.
+    int p[2][2];
+    if (pipe2(p[0], O_CLOEXEC) != 0) throw_io_error("create a pipe for", "run.log");
+    if (pipe2(p[1], O_CLOEXEC) != 0) {
+      const int err = errno;
+      for (int fd : p[0]) ::close(fd);
+      throw_io_error("create a pipe for", "run.log", err);
+    }
     for (int k = 0; k < 2; ++k) {
-      int p[2];
-      if (pipe2(p, O_CLOEXEC) != 0) throw_io_error("create a pipe for", "run.log");
       saved_[k] = fcntl(k + 1, F_DUPFD_CLOEXEC, 3);
-      dup2(p[1], k + 1);
-      ::close(p[1]);
-      read_[k] = p[0];
+      dup2(p[k][1], k + 1);
+      ::close(p[k][1]);
+      read_[k] = p[k][0];
     }
     // Signals stay with the main thread: its SIGINT/SIGTERM handler writes the checkpoint.
     sigset_t all, old;
