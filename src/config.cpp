@@ -4,7 +4,9 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -140,14 +142,18 @@ const std::vector<KeySpec>& schema() {
                      "the config file's folder."));
     s.push_back(integer("particles.init_frame", &C::particles, &C::ParticlesCfg::init_frame, -1,
                         1e12, "", "Frame of an H5MD init_file to start from (-1 = last)."));
-    s.push_back(real("flow.J", &C::flow, &C::Flow::j, 0.0, 10.0, true, "1 (= gammadot eta/P)",
+    // Below ~1e-10 the viscous forces (~J) are too small beside the contact springs for the
+    // solve: at J = 1e-20 its residual check fails (measured, issue 16).
+    s.push_back(real("flow.J", &C::flow, &C::Flow::j, 1e-10, 10.0, false, "1 (= gammadot eta/P)",
                      "Viscous number; in model units this is the shear rate gammadot."));
     s.push_back(real("flow.lz", &C::flow, &C::Flow::lz, 0.0, 100.0, true, "d",
                      "Thickness given to the monolayer for stresses and the wall load P Lx lz."));
     s.push_back(boolean("lubrication.enabled", &C::lubrication, &C::Lubrication::enabled,
                         "Pairwise lubrication and lubrication-matched contact dashpots."));
-    s.push_back(real("lubrication.delta", &C::lubrication, &C::Lubrication::delta, 0.0, 0.5, true,
-                     "1 (reduced gap)", "Regularisation of the lubrication singularity."));
+    // The squeeze resistance at contact grows as 1/delta: at delta = 1e-20 the resistance
+    // matrix is no longer positive definite in double precision (measured, issue 16).
+    s.push_back(real("lubrication.delta", &C::lubrication, &C::Lubrication::delta, 1e-10, 0.5,
+                     false, "1 (reduced gap)", "Regularisation of the lubrication singularity."));
     s.push_back(real("lubrication.h_max", &C::lubrication, &C::Lubrication::h_max, 0.0, 1.0, true,
                      "1 (reduced gap)",
                      "Lubrication cut-off: active for 0 < h < h_max (must be < 1).",
@@ -454,6 +460,27 @@ void check_combinations(const Config& c, const std::string& origin) {
     fail(origin, "output.frame_strain",
          fmt::format("{:g} is larger than run.strain = {:g}: no frame would be written",
                      c.output.frame_strain, c.run.strain));
+  // A spacing far below the run's strain asks for more frames (or checkpoints, each a full
+  // state on disk) than any disk holds, and one below the rounding of the strain never
+  // advances: both are mistakes, refused with the smallest spacing allowed.
+  const auto check_spacing = [&](const char* key, double spacing, const char* what) {
+    if (spacing > 0.0 && c.run.strain / spacing > kMaxOutputsPerRun)
+      fail(origin, key,
+           fmt::format("{:g} asks for run.strain / {} = {:.3g} {}; at most {:g} are allowed, "
+                       "i.e. {} >= {:g}",
+                       spacing, key, c.run.strain / spacing, what, kMaxOutputsPerRun, key,
+                       c.run.strain / kMaxOutputsPerRun));
+  };
+  check_spacing("output.frame_strain", c.output.frame_strain, "frames");
+  check_spacing("output.checkpoint_strain", c.output.checkpoint_strain, "checkpoints");
+}
+
+// Whether the document (already parsed once without error) or an override sets scene.type.
+bool names_scene(const std::string& toml_text, const std::vector<std::string>& overrides) {
+  for (const auto& o : overrides)
+    if (o.rfind("scene.type=", 0) == 0) return true;
+  const toml::table root = toml::parse(toml_text);
+  return root["scene"]["type"].is_string();
 }
 
 }  // namespace
@@ -483,6 +510,11 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
   }
   apply_table(cfg, root, origin);
   for (const auto& o : overrides) {
+    // TOML would read the text after a line break as further keys, silently set.
+    if (o.find_first_of("\r\n") != std::string::npos)
+      throw ConfigError(fmt::format(
+          "--set {}: the value holds a line break; give one section.key=value per --set",
+          o.substr(0, o.find_first_of("\r\n"))));
     const auto eq = o.find('=');
     const auto dot = o.find('.');
     if (eq == std::string::npos || dot == std::string::npos || dot > eq)
@@ -511,11 +543,34 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
 }
 
 Config load_config(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  // A directory opens as an empty stream on Linux: it would run the defaults.
+  std::error_code ec;
+  const auto status = std::filesystem::status(file, ec);
+  if (ec)
+    throw ConfigError(
+        fmt::format("{}: cannot open the config file: {}", file.string(), ec.message()));
+  if (!std::filesystem::is_regular_file(status))
+    throw ConfigError(fmt::format("{}: cannot open the config file: {}", file.string(),
+                                  std::filesystem::is_directory(status)
+                                      ? "it is a directory, not a TOML file"
+                                      : "it is not a regular file"));
   std::ifstream in(file);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open the config file", file.string()));
+  if (!in)
+    throw ConfigError(fmt::format("{}: cannot open the config file: {}", file.string(),
+                                  std::strerror(errno)));
   std::stringstream ss;
   ss << in.rdbuf();
-  Config cfg = parse_config(ss.str(), file.string(), overrides);
+  if (in.bad())
+    throw ConfigError(fmt::format("{}: cannot read the config file: {}", file.string(),
+                                  std::strerror(errno)));
+  const std::string text = ss.str();
+  Config cfg = parse_config(text, file.string(), overrides);
+  // An empty or truncated file would otherwise run the default scene: the scene is the one
+  // key a config file must give.
+  if (!names_scene(text, overrides))
+    fail(file.string(), "scene.type",
+         "missing: a config file must say which scene it runs, e.g. [scene] type = "
+         "\"pressure_shear\" (or \"simple_shear\")");
   auto& init = cfg.particles.init_file;
   if (!init.empty() && std::filesystem::path(init).is_relative())
     init = (file.parent_path() / init).lexically_normal().string();

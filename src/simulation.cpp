@@ -12,9 +12,14 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/hdf5_diagnostics.hpp"
+#include "sheardiff/io/io_error.hpp"
+#include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
@@ -38,6 +43,10 @@ FrictionalContact contact_of(const Config& cfg) {
 }
 
 }  // namespace
+
+double interaction_range_factor(const Config& cfg) {
+  return cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
+}
 
 double explicit_stability_dt(const Config& cfg) {
   // The fastest spring mode is the smallest pair (two small discs): its normal and slip
@@ -77,15 +86,42 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
           origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
           limit));
   }
+  double lx = 0.0, ly = 0.0, amax = 0.5 * std::max(1.0, cfg.particles.size_ratio);
   if (!cfg.particles.init_file.empty()) {
     try {
-      (void)initial_packing(cfg);
+      const Packing pk = initial_packing(cfg);
+      lx = pk.lx, ly = pk.ly;
+      for (double a : pk.radius) amax = std::max(amax, a);
     } catch (const ConfigError& e) {
       throw ConfigError(fmt::format("{}: {}", origin, e.what()));
     } catch (const std::exception& e) {
       throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
     }
+  } else {
+    // The cell random_packing makes, without placing anything.
+    double area = 0.0;
+    for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio)) {
+      const double a = s == 0 ? 0.5 : 0.5 * cfg.particles.size_ratio;
+      area += kPi * a * a;
+    }
+    lx = std::sqrt(area / cfg.particles.phi_init / cfg.particles.aspect);
+    ly = cfg.particles.aspect * lx;
   }
+  // The neighbour list holds one image of each pair: a periodic edge within two list cut-offs
+  // of the largest pair lets a disc meet its own image (ignored, so its stress is lost) or a
+  // pair meet twice (one contact history for two images).
+  const double cutoff = 2.0 * amax * interaction_range_factor(cfg) + cfg.neighbour.skin;
+  const bool periodic_y = cfg.scene.type == "simple_shear";
+  const double edge = periodic_y ? std::min(lx, ly) : lx;
+  if (!(edge > 2.0 * cutoff))
+    throw ConfigError(fmt::format(
+        "{}: particles.N: the periodic cell is {:.3g} x {:.3g} d ({} = {:.3g} d), but a periodic "
+        "edge must exceed twice the neighbour cut-off of the largest pair, 2 x {:.3g} = {:.3g} d "
+        "(diameter {:g} d, lubrication range and neighbour.skin = {:g} d), or a disc meets its "
+        "own image; raise particles.N{}, lower neighbour.skin or lubrication.h_max",
+        origin, lx, ly, periodic_y && ly < lx ? "Ly" : "Lx", edge, cutoff, 2.0 * cutoff, 2.0 * amax,
+        cfg.neighbour.skin,
+        cfg.particles.init_file.empty() ? ", bring particles.aspect closer to 1" : ""));
 }
 
 Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
@@ -101,7 +137,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.end_time = cfg.run.strain / cfg.flow.j;
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
-  const double range = cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
+  const double range = interaction_range_factor(cfg);
   ForceBalance fb(lubrication_of(cfg), contact_of(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
@@ -162,29 +198,119 @@ struct StopSignals {
   }
 };
 
-// 2: the run health state was added.
-constexpr const char* kCheckpointMagic = "sheardiff-checkpoint-2";
+// A reader's runtime_error on a checkpoint whose checksum held means another build's state
+// layout; on an unchecked (version 2) one, corruption. Either way it is not resumed.
+[[noreturn]] void unreadable_checkpoint(const std::filesystem::path& file, const char* what) {
+  throw CorruptCheckpoint(fmt::format(
+      "{} cannot be read: {}. It was neither resumed nor changed; keep a copy if you need it, "
+      "then start the run again with --overwrite",
+      file.string(), what));
+}
 
-std::vector<char> read_bytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error(fmt::format("{}: cannot read the checkpoint", file.string()));
-  return std::vector<char>(std::istreambuf_iterator<char>(in), {});
+// Whether DIR/config.toml holds this resolved configuration (compared through the parser, so
+// that keys added to the code since do not make it look foreign).
+bool same_config(const std::filesystem::path& file, const std::string& resolved) {
+  try {
+    return to_toml(load_config(file)) == resolved;
+  } catch (const ConfigError&) {
+    return false;
+  }
+}
+
+std::string refusal(const RunDirectory& dir) {
+  const std::string d = dir.path().string();
+  switch (dir.state()) {
+    case RunState::finished:
+      return fmt::format(
+          "{} holds a finished run (summary.json); it is left as it is. To run there again add "
+          "--overwrite (this deletes its results), or choose another --out",
+          d);
+    case RunState::interrupted:
+      return fmt::format(
+          "{} holds an interrupted run (checkpoint.bin); it is left as it is. Continue it with "
+          "`sheardiff run CONFIG --resume {}`, or add --overwrite to discard it",
+          d, d);
+    case RunState::started:
+      return fmt::format(
+          "{} holds a run that stopped before its first checkpoint ({}); it is left as it is. "
+          "`sheardiff run CONFIG --resume {}` starts it again from strain 0, --overwrite "
+          "replaces it",
+          d, dir.run_files_present(), d);
+    case RunState::empty:
+      break;
+  }
+  return {};
 }
 
 }  // namespace
 
-nlohmann::json run_to_directory(const Config& given, const std::filesystem::path& out_dir,
+double next_output_strain(double next, double spacing, double strain) {
+  const double until = strain * (1.0 + 1e-12);
+  // A spacing far below one step (a Config made in code is not range checked): skip ahead
+  // instead of adding it billions of times.
+  if (next <= until && (until - next) / spacing > 1e6)
+    next += std::floor((until - next) / spacing) * spacing;
+  while (next <= until) {
+    const double after = next + spacing;
+    if (!(after > next)) return std::nextafter(until, std::numeric_limits<double>::infinity());
+    next = after;
+  }
+  return next;
+}
+
+nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume) {
+  RunDirectory dir(out_dir, !resume);
+  return run_to_directory(cfg, dir, resume ? RunMode::resume : RunMode::start, progress);
+}
+
+// A function-try-block: every failure of the run passes the handlers at the end.
+nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode,
+                                bool progress) try {
+  // From here SIGINT/SIGTERM only set a flag: a signal during the set-up (minutes for a large
+  // packing) stops the run at step 0 with a checkpoint instead of leaving a bare directory.
+  StopSignals signals;
   Config cfg = given;
   resolve_defaults(cfg);
   const std::string resolved = to_toml(cfg);
-  const auto checkpoint_file = out_dir / "checkpoint.bin";
-  std::vector<char> checkpoint;
-  if (resume) {
-    if (!std::filesystem::exists(checkpoint_file))
-      throw ConfigError(fmt::format("--resume {}: no checkpoint.bin there", out_dir.string()));
-    checkpoint = read_bytes(checkpoint_file);
+  const std::filesystem::path& out_dir = dir.path();
+  const std::string out = out_dir.string();
+  const auto checkpoint_file = dir.file("checkpoint.bin");
+
+  // What is there decides what may be done; nothing is changed before the decision.
+  const RunState state = dir.state();
+  if (mode == RunMode::start && state != RunState::empty) throw ConfigError(refusal(dir));
+  if (mode == RunMode::resume) {
+    if (state == RunState::empty)
+      throw ConfigError(fmt::format("--resume {}: there is no run there to resume", out));
+    if (std::filesystem::exists(dir.file("config.toml")) &&
+        !same_config(dir.file("config.toml"), resolved))
+      throw ConfigError(fmt::format(
+          "--resume {}: the configuration differs from the one the run was started with (see "
+          "{}/config.toml)",
+          out, out));
   }
+  if (mode == RunMode::resume && state == RunState::finished) {
+    // A run killed between its summary and the removal of its checkpoint is finished: say so,
+    // and complete the removal.
+    dir.start_log("resume of a finished run: " + this_command_line());
+    std::error_code ec;
+    std::filesystem::remove(checkpoint_file, ec);
+    std::fprintf(stderr, "%s: the run has already finished (summary.json); nothing to resume\n",
+                 out.c_str());
+    std::ifstream in(dir.file("summary.json"));
+    nlohmann::json js;
+    try {
+      js = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      throw IoError(fmt::format("cannot read {}: {}", dir.file("summary.json").string(), e.what()));
+    }
+    return js;
+  }
+  const bool from_checkpoint = mode == RunMode::resume && state == RunState::interrupted;
+  CheckpointPayload checkpoint;
+  if (from_checkpoint) checkpoint = read_checkpoint_file(checkpoint_file);
+
   // The initial state is built before anything is written: a bad input file leaves no output.
   Simulation sim(cfg);
   Dynamics& d = sim.dynamics();
@@ -192,13 +318,6 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   // The residual is one sparse product per solve, small next to the factorisation.
   d.force_balance().set_check_residual(true);
   RunHealth health(cfg, d);
-  if (!resume) {
-    std::filesystem::create_directories(out_dir);
-    std::filesystem::remove(checkpoint_file);
-    std::filesystem::remove(out_dir / "summary.json");
-    std::filesystem::remove(out_dir / "diagnostic.txt");
-    write_file_atomically(out_dir / "config.toml", resolved);
-  }
   auto observers = make_observers(cfg, out_dir);
 
   double next_frame = cfg.output.frame_strain;
@@ -206,11 +325,9 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   double elapsed_before = 0.0;
   long frames = 0;
   // The whole evolving state of the run, in one fixed order for saving and loading.
-  const auto serialize = [&](Archive& a) {
-    std::string magic = kCheckpointMagic, config = resolved;
-    a.io(magic);
-    if (magic != kCheckpointMagic)
-      throw std::runtime_error("checkpoint: not a sheardiff checkpoint");
+  // with_counters: version 3 checkpoints also hold the solver's work counters.
+  const auto serialize = [&](Archive& a, bool with_counters) {
+    std::string config = resolved;
     a.io(config);
     if (config != resolved)
       throw ConfigError(fmt::format(
@@ -222,11 +339,36 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     for (auto& o : observers) o->serialize(a);
     health.serialize(a);
     a.io(next_frame), a.io(next_checkpoint), a.io(elapsed_before), a.io(frames);
+    if (with_counters) d.force_balance().system().serialize_counters(a);
   };
-  if (resume) {
-    Archive a = Archive::reader(std::move(checkpoint));
-    serialize(a);
+  if (from_checkpoint) {
+    Archive a = Archive::reader(std::move(checkpoint.bytes));
+    try {
+      serialize(a, checkpoint.checksummed);
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& e) {
+      unreadable_checkpoint(checkpoint_file, e.what());
+    }
+    if (!a.at_end()) unreadable_checkpoint(checkpoint_file, "bytes are left after the state");
   }
+
+  // Only now is the directory changed: a new run starts from nothing of an earlier one.
+  if (from_checkpoint)
+    dir.remove_partial_files();
+  else
+    dir.remove_run_files(/*keep_log=*/mode == RunMode::resume);
+  dir.start_log(this_command_line());
+  if (from_checkpoint && !checkpoint.checksummed)
+    std::fprintf(stderr,
+                 "warning: %s has no checksum (written by an older sheardiff): resumed unchecked\n",
+                 checkpoint_file.c_str());
+  if (mode == RunMode::resume && !from_checkpoint)
+    std::fprintf(stderr,
+                 "%s: no checkpoint was written before the run stopped: starting again "
+                 "from strain 0\n",
+                 out.c_str());
+  if (!from_checkpoint) write_file_atomically(dir.file("config.toml"), resolved);
 
   std::vector<std::string> names, units;
   for (const auto& o : observers) {
@@ -250,22 +392,23 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     layout.author = cfg.output.author;
     layout.creator_version = SHEARDIFF_VERSION;
     layout.config_toml = resolved;
-    const auto file = out_dir / "trajectory.h5";
-    writer = resume ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, frames))
-                    : std::make_unique<H5mdWriter>(file, layout);
+    const auto file = dir.file("trajectory.h5");
+    writer = from_checkpoint
+                 ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, frames))
+                 : std::make_unique<H5mdWriter>(file, layout);
   }
   const auto save_checkpoint = [&](double elapsed_now) {
     if (writer) writer->flush();  // the trajectory holds every frame the checkpoint counts
     Archive a = Archive::writer();
     double total = elapsed_before + elapsed_now;
     std::swap(total, elapsed_before);
-    serialize(a);
+    serialize(a, true);
     std::swap(total, elapsed_before);
     // Whole or absent: a checkpoint is never half-written.
-    write_file_atomically(checkpoint_file, a.bytes().data(), a.bytes().size());
+    const std::vector<char> bytes = checkpoint_file_bytes(a.bytes());
+    write_file_atomically(checkpoint_file, bytes.data(), bytes.size());
   };
 
-  StopSignals signals;
   const bool tty = progress && isatty(fileno(stderr));
   const auto t0 = std::chrono::steady_clock::now();
   const auto seconds = [&] {
@@ -283,7 +426,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   // kept) and a diagnostic frame.
   const auto stop = [&](const HealthReport& r) {
     if (r.state_finite) save_checkpoint(seconds());
-    write_diagnostic(out_dir / "diagnostic.txt", d, sim.integrator().velocities(), r);
+    write_diagnostic(dir.file("diagnostic.txt"), d, sim.integrator().velocities(), r);
     if (tty) std::fprintf(stderr, "\n");
     throw RunUnhealthy(r);
   };
@@ -305,7 +448,7 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
     const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
     for (const auto& o : observers) o->on_step(view);
     if (d.strain() >= next_frame * (1.0 - 1e-12)) {
-      while (next_frame <= d.strain() * (1.0 + 1e-12)) next_frame += cfg.output.frame_strain;
+      next_frame = next_output_strain(next_frame, cfg.output.frame_strain, d.strain());
       values.clear();
       for (const auto& o : observers) o->on_frame(view, values);
       if (writer) {
@@ -326,8 +469,8 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
       }
       ++frames;
       if (cfg.output.checkpoint_strain > 0.0 && d.strain() >= next_checkpoint * (1.0 - 1e-12)) {
-        while (next_checkpoint <= d.strain() * (1.0 + 1e-12))
-          next_checkpoint += cfg.output.checkpoint_strain;
+        next_checkpoint =
+            next_output_strain(next_checkpoint, cfg.output.checkpoint_strain, d.strain());
         save_checkpoint(seconds());
       }
     }
@@ -361,6 +504,9 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   if (tty) std::fprintf(stderr, "\n");
   const double wall = elapsed_before + seconds();
 
+  // The end of the run. Every write below replaces what an earlier attempt may have written
+  // (tables, analysis.h5, summary.json), so a death anywhere in it resumes from the last
+  // checkpoint and completes; summary.json, written last, marks the run finished.
   nlohmann::json js;
   js["scene"] = cfg.scene.type;
   js["N"] = cfg.particles.n;
@@ -386,7 +532,9 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   }
   js["lx"] = d.box().lx;
   js["ly"] = d.height();
-  for (const auto& o : observers) o->finish(d, js, writer.get());
+  dir.with_hdf5_reasons([&] {
+    for (const auto& o : observers) o->finish(d, js, writer.get());
+  });
   health.report(js);
   if (!js.contains("phi")) {
     double area = 0;
@@ -395,10 +543,38 @@ nlohmann::json run_to_directory(const Config& given, const std::filesystem::path
   }
   if (writer) writer->flush();
   writer.reset();
-  write_file_atomically(out_dir / "summary.json", js.dump(2) + "\n");
+  // analysis.h5 is written by code that does not check its file's close: a full disk there
+  // leaves a truncated file under the final name, which HDF5 then refuses to open.
+  const auto analysis = dir.file("analysis.h5");
+  if (cfg.analysis.diffusion && std::filesystem::exists(analysis) && !hdf5_file_opens(analysis)) {
+    std::filesystem::remove(analysis);
+    const std::string reason = dir.hdf5_log() ? dir.hdf5_log()->last_os_reason() : "";
+    throw IoError(fmt::format("cannot write {}: {}", analysis.string(),
+                              reason.empty() ? "the file was left incomplete" : reason));
+  }
+  write_file_atomically(dir.file("summary.json"), js.dump(2) + "\n");
   // Finished: the summary marks the run complete and the checkpoint has served its purpose.
   std::filesystem::remove(checkpoint_file);
   return js;
+} catch (const IoError& e) {
+  // Once the run has taken charge of the directory (its log started), a failure leaves it
+  // resumable: the last checkpoint whole (it is never half-written), no FILE.tmp, and the user
+  // told how to go on.
+  if (!dir.logging()) throw;
+  dir.remove_partial_files();
+  const std::string out = dir.path().string();
+  throw IoError(fmt::format(
+      "{}. {}", e.what(),
+      dir.state() == RunState::interrupted
+          ? fmt::format("{} is intact: once the cause is fixed, continue with `sheardiff run "
+                        "CONFIG --resume {}`",
+                        dir.file("checkpoint.bin").string(), out)
+          : fmt::format("No checkpoint was written yet: once the cause is fixed, `sheardiff run "
+                        "CONFIG --resume {}` starts the run again",
+                        out)));
+} catch (...) {
+  if (dir.logging()) dir.remove_partial_files();
+  throw;
 }
 
 }  // namespace sheardiff

@@ -9,6 +9,8 @@ PKGS=(build-essential cmake ninja-build pkg-config
       libeigen3-dev libnanoflann-dev libhdf5-dev libtomlplusplus-dev libcli11-dev
       libfmt-dev nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev
       libsuitesparse-dev libopenblas0-pthread
+      zlib1g-dev  # crc32 of checkpoints
+      strace      # the ctest run_dir_final_phase_kill (tests/cli/final_phase_kill.sh)
       clang-14 libclang-rt-14-dev  # libFuzzer for the ctest fuzz_config_smoke (tests/fuzz/)
       python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
       python3-gsd)  # the GSD export (tools/h5md_to_gsd.py) and its ctest h5md_outside_readers

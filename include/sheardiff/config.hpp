@@ -105,9 +105,15 @@ struct ConfigError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Largest number of trajectory frames, and of checkpoints, one run may ask for
+// (run.strain / output.frame_strain, run.strain / output.checkpoint_strain).
+inline constexpr double kMaxOutputsPerRun = 1e7;
+
 // Parse a TOML document (origin names it in errors) and apply "section.key=value" overrides.
 Config parse_config(const std::string& toml_text, const std::string& origin,
                     const std::vector<std::string>& overrides = {});
+// A config file: parse_config, and further the file must be a regular file and must set
+// scene.type (an empty file is not a run of the default scene).
 Config load_config(const std::filesystem::path& file,
                    const std::vector<std::string>& overrides = {});
 // Fills the defaults that depend on other keys (output.frame_strain = 0 -> from J). Done by

@@ -38,6 +38,9 @@ class Simulation {
   std::unique_ptr<Dynamics> dynamics_;
 };
 
+// Pair interaction range over the sum of the radii: lubrication reaches gaps up to h_max.
+double interaction_range_factor(const Config& cfg);
+
 // Contact stability limit of explicit springs for these parameters (model.md section 7).
 double explicit_stability_dt(const Config& cfg);
 
@@ -50,8 +53,9 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
 bool rotational_unknowns(const Config& cfg);
 
 // The checks of a configuration that need the physics or input files (parse_config does the
-// rest): a fixed dt of explicit springs below their stability limit, and particles.init_file
-// readable with particles.N mobile particles. Throws ConfigError naming origin and the key.
+// rest): a fixed dt of explicit springs below their stability limit, particles.init_file
+// readable with particles.N mobile particles, and a periodic cell wider than two neighbour
+// cut-offs of the largest pair. Throws ConfigError naming origin and the key.
 // Writes nothing: `sheardiff check` and `run` call it before any output exists.
 void validate_run_inputs(const Config& cfg, const std::string& origin);
 
@@ -61,11 +65,29 @@ struct RunInterrupted : std::runtime_error {
   int signal;
 };
 
-// Runs cfg to its end, writing trajectory.h5 (H5MD), config.toml, checkpoint.bin every
-// output.checkpoint_strain, and at the end summary.json (whose presence marks a finished run;
-// the checkpoint is then removed). resume = continue from out_dir/checkpoint.bin, cutting the
-// trajectory back to the checkpoint's frames; the continuation is bit-identical to a run that
-// was never stopped. Returns the summary.
+// The next frame (or checkpoint) strain after `strain`: `next` advanced by whole `spacing`s,
+// as repeated addition does, but in bounded time whatever the spacing.
+double next_output_strain(double next, double spacing, double strain);
+
+class RunDirectory;
+// How run_to_directory treats what DIR already holds (docs/stability.md, "Run directories"):
+//   start      DIR must hold no run;
+//   overwrite  the run files of any earlier run are removed first;
+//   resume     continue DIR's run: from its checkpoint; from strain 0 if it stopped before
+//              its first one; a finished run is left as it is (its checkpoint, if a death
+//              left one behind, removed) and its summary returned.
+enum class RunMode { start, overwrite, resume };
+
+// Runs cfg to its end in the locked directory `dir`, writing trajectory.h5 (H5MD), config.toml,
+// checkpoint.bin every output.checkpoint_strain, run.log, and at the end summary.json (whose
+// presence marks a finished run; the checkpoint is then removed). A resumed run cuts the
+// trajectory back to the checkpoint's frames and continues bit-identically to a run never
+// stopped. Nothing in DIR is changed before the configuration, the initial state and the
+// checkpoint have been checked. Throws ConfigError (exit 2: refused, nothing changed), IoError
+// (exit 1: DIR left resumable), RunUnhealthy (4), RunInterrupted (128 + signal). Returns the
+// summary.
+nlohmann::json run_to_directory(const Config& cfg, RunDirectory& dir, RunMode mode, bool progress);
+// The same in a RunDirectory of its own: resume ? RunMode::resume : RunMode::start.
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume = false);
 

@@ -6,19 +6,28 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <optional>
+#include <system_error>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/hdf5_diagnostics.hpp"
+#include "sheardiff/io/io_error.hpp"
+#include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace {
-// Exit codes (README, docs/stability.md): 0 done, 2 invalid config or input, 3 the run failed
-// numerically outside the step loop, 4 stopped by a run health check (kExitUnhealthy), 1
-// anything else (I/O), 128 + signal after SIGINT/SIGTERM.
+// Exit codes (README, docs/stability.md): 0 done, 1 I/O and other errors, 2 refused before
+// anything was changed (invalid configuration, input file or command line; a run directory in
+// use or holding a run the command may not touch; a corrupt checkpoint), 3 a numerical failure
+// outside the step loop, or a sweep with points that failed or did not finish, 4 stopped by a
+// run health check (kExitUnhealthy), 128 + signal after SIGINT/SIGTERM.
+constexpr int kExitIo = 1;
 constexpr int kExitConfig = 2;
 constexpr int kExitNumerical = 3;
 int run_sweep(const std::string& file, const std::filesystem::path& out, int jobs,
@@ -46,6 +55,7 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
       throw;
     }
   }
+  int failed = 0;
   if (!collect_only) {
     const auto exe = std::filesystem::read_symlink("/proc/self/exe");
     if (backend == "slurm") {
@@ -56,7 +66,7 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
           array.empty() ? "none" : array, collect, out.string());
       return 0;
     }
-    const int failed = sd::run_local(spec, out, jobs > 0 ? jobs : spec.jobs, exe);
+    failed = sd::run_local(spec, out, jobs > 0 ? jobs : spec.jobs, exe);
     if (failed > 0)
       fmt::print(stderr, "sweep: {} point(s) failed; collecting the others\n", failed);
   }
@@ -78,7 +88,15 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
                  f["phi_of_J"]["a"].get<double>(), f["phi_of_J"]["b"].get<double>());
     fmt::print("\n");
   }
-  return fits["finished"].get<long>() == fits["points"].get<long>() ? 0 : kExitNumerical;
+  if (failed > 0 || fits["finished"].get<long>() != fits["points"].get<long>()) {
+    fmt::print(
+        stderr, "sweep: {} of {} points not finished{}\n",
+        fits["points"].get<long>() - fits["finished"].get<long>(), fits["points"].get<long>(),
+        failed > 0 ? fmt::format(" ({} failed in this sweep; see {}/logs)", failed, out.string())
+                   : "");
+    return kExitNumerical;
+  }
+  return 0;
 }
 
 // A summary value, NaN when absent or not a number: summaries of older versions or of runs
@@ -111,6 +129,7 @@ int main(int argc, char** argv) {
     setenv("OMP_THREAD_LIMIT", "1", 1);
     execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
   }
+  sheardiff::quiet_hdf5_for_process();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
   app.require_subcommand(1);
 
@@ -120,16 +139,26 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "Run a configuration to its end");
   run->add_option("config", config_path, "Configuration file (TOML, see docs/config.md)")
       ->required();
-  run->add_option("--out", out_dir,
-                  "Output folder: trajectory.h5 (H5MD), summary.json, config.toml")
-      ->capture_default_str();
+  auto* out_opt =
+      run->add_option("--out", out_dir,
+                      "Output folder: trajectory.h5 (H5MD), summary.json, config.toml, "
+                      "run.log. A folder holding a run is refused (see --resume, --overwrite)")
+          ->capture_default_str();
   run->add_option("--set", overrides,
                   "Override one key, section.key=value (repeatable), e.g. --set flow.J=1e-3");
   std::string resume_dir;
-  run->add_option("--resume", resume_dir,
-                  "Continue the run in DIR from its checkpoint.bin (same CONFIG and --set); the "
-                  "trajectory is cut back to the checkpoint, the result is bit-identical to an "
-                  "uninterrupted run");
+  auto* resume_opt = run->add_option(
+      "--resume", resume_dir,
+      "Continue the run in DIR from its checkpoint.bin (same CONFIG and --set); the "
+      "trajectory is cut back to the checkpoint, the result is bit-identical to an "
+      "uninterrupted run. A run stopped before its first checkpoint starts again; a finished "
+      "one is left as it is");
+  bool overwrite = false;
+  auto* overwrite_opt = run->add_flag(
+      "--overwrite", overwrite,
+      "Run in --out DIR even if it holds a run: every file of that run is deleted first");
+  resume_opt->excludes(out_opt);
+  resume_opt->excludes(overwrite_opt);
 
   auto* check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
@@ -165,15 +194,54 @@ int main(int argc, char** argv) {
                   "Only collect finished points into sweep.csv and "
                   "fits.json (what the Slurm collect job does)");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a ParseError with exit code 0; every usage error is exit 2.
+    return app.exit(e) == 0 ? 0 : kExitConfig;
+  }
 
+  // The run directory, locked, lives until main returns: what is printed below, error
+  // messages included, goes to its run.log too.
+  std::optional<sheardiff::RunDirectory> dir;
   try {
     if (doc->parsed()) {
       std::cout << sheardiff::config_reference_markdown();
       return 0;
     }
     if (analyse->parsed()) {
-      const auto js = sheardiff::reanalyse_run(run_dir);
+      dir.emplace(run_dir, false);
+      if (dir->state() != sheardiff::RunState::finished)
+        throw sheardiff::ConfigError(fmt::format(
+            "{}: analyse needs a finished run (summary.json); this directory holds {}", run_dir,
+            dir->state() == sheardiff::RunState::empty ? "no run" : "a run that has not finished"));
+      const auto run_cfg = sheardiff::load_config(dir->file("config.toml"));
+      {
+        // Read here so that a damaged summary is named (reanalyse_run would not name it).
+        std::ifstream in(dir->file("summary.json"));
+        try {
+          const auto summary = nlohmann::json::parse(in);
+          (void)summary;
+        } catch (const nlohmann::json::exception& e) {
+          throw sheardiff::ConfigError(fmt::format("{}: not a valid summary: {}",
+                                                   dir->file("summary.json").string(), e.what()));
+        }
+      }
+      if (!run_cfg.output.trajectory)
+        throw sheardiff::ConfigError(fmt::format(
+            "{}: the run was made with output.trajectory = false: there is no trajectory to "
+            "analyse",
+            run_dir));
+      dir->start_log(sheardiff::this_command_line());
+      dir->remove_partial_files();  // of an earlier analyse killed while writing
+      nlohmann::json js;
+      dir->with_hdf5_reasons([&] { js = sheardiff::reanalyse_run(run_dir); });
+      // Its writer does not check the file's close: a full disk leaves it truncated.
+      if (!sheardiff::hdf5_file_opens(dir->file("analysis.h5")))
+        throw sheardiff::IoError(fmt::format(
+            "cannot write {}: {}", dir->file("analysis.h5").string(),
+            dir->hdf5_log()->last_os_reason().empty() ? "the file was left incomplete"
+                                                      : dir->hdf5_log()->last_os_reason()));
       fmt::print(
           "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
           "(log-log slope {:.3f}); dv = {:.4g} +- {:.2g} gammadot d; Psi = {:.4g} +- {:.2g} / "
@@ -205,7 +273,19 @@ int main(int argc, char** argv) {
     }
     const bool resume = !resume_dir.empty();
     if (resume) out_dir = resume_dir;
-    const auto summary = sheardiff::run_to_directory(cfg, out_dir, true, resume);
+    using sheardiff::RunMode;
+    const RunMode mode = resume ? RunMode::resume : overwrite ? RunMode::overwrite : RunMode::start;
+    // --overwrite deletes DIR/config.toml: it must not be the file the user runs.
+    std::error_code same_ec;
+    if (mode == RunMode::overwrite &&
+        std::filesystem::equivalent(config_path, std::filesystem::path(out_dir) / "config.toml",
+                                    same_ec))
+      throw sheardiff::ConfigError(fmt::format(
+          "{} is the config.toml of the run in {}, which --overwrite deletes: copy it elsewhere "
+          "and run that copy",
+          config_path, out_dir));
+    dir.emplace(out_dir, mode != RunMode::resume);
+    const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, true);
     const auto flag = [&](const char* key) {
       const auto it = summary.find(key);
       return it != summary.end() && it->is_boolean() && it->get<bool>();
@@ -261,11 +341,17 @@ int main(int argc, char** argv) {
   } catch (const sheardiff::ConfigError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitConfig;
+  } catch (const sheardiff::IoError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitIo;
+  } catch (const std::system_error& e) {  // std::filesystem errors: they name the path
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitIo;
   } catch (const std::runtime_error& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitNumerical;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
-    return 1;
+    return kExitIo;
   }
 }

@@ -17,6 +17,9 @@
 #include <type_traits>
 #include <utility>
 
+#include "sheardiff/io/hdf5_diagnostics.hpp"
+#include "sheardiff/io/io_error.hpp"
+
 namespace sheardiff {
 
 namespace fs = std::filesystem;
@@ -76,8 +79,9 @@ class ErrorPrintGuard {
 };
 
 [[noreturn]] void fail(const fs::path& file, std::string_view object, std::string_view what) {
-  throw std::runtime_error(
-      fmt::format("H5MD file '{}', object '{}': {}", file.string(), object, what));
+  const std::string reason = hdf5_os_reason();
+  throw IoError(fmt::format("H5MD file '{}', object '{}': {}{}{}", file.string(), object, what,
+                            reason.empty() ? "" : ": ", reason));
 }
 
 Handle checked(hid_t id, Closer closer, const fs::path& file, std::string_view object,
@@ -926,8 +930,11 @@ void H5mdWriter::write_table(const std::string& name, const std::vector<std::str
                      values.cols()));
   }
   for (const auto& c : columns) check_name(c, m.path, "column");
+  // Replaced, not refused: a run resumed from a checkpoint taken before its end writes its
+  // tables again over those a killed attempt had written.
   if (H5Lexists(m.file.get(), group_name.c_str(), H5P_DEFAULT) > 0) {
-    fail(m.path, group_name, "object already exists");
+    check(H5Ldelete(m.file.get(), group_name.c_str(), H5P_DEFAULT), m.path, group_name,
+          "cannot replace the table");
   }
   Handle group = create_group(m.file.get(), group_name, m.path);
   for (std::size_t c = 0; c < columns.size(); ++c) {

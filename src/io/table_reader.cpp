@@ -1,7 +1,9 @@
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <string>
@@ -45,7 +47,8 @@ bool parse_double(std::string_view tok, double& value) {
 TableConfiguration read_position_table(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) {
-    throw std::runtime_error(fmt::format("position table '{}': cannot open file", file.string()));
+    throw std::runtime_error(fmt::format("position table '{}': cannot open file: {}", file.string(),
+                                         std::strerror(errno)));
   }
   TableConfiguration cfg;
   std::string line;
@@ -72,7 +75,8 @@ TableConfiguration read_position_table(const std::filesystem::path& file) {
     cfg.diameter.push_back(v[2]);
   }
   if (in.bad()) {
-    throw std::runtime_error(fmt::format("position table '{}': read error", file.string()));
+    throw std::runtime_error(
+        fmt::format("position table '{}': read error: {}", file.string(), std::strerror(errno)));
   }
   return cfg;
 }

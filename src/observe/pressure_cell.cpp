@@ -223,10 +223,11 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["measured_strain"] = d.strain() - steady_at_;
   add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, d.strain(),
                     error_block_);
+  // Into summary.json (written whole or not at all), not into the trajectory: an HDF5 file
+  // killed while its metadata is being changed can be left unreadable, and the end of a run
+  // must be resumable at every instant (tests/cli/final_phase_kill.sh).
   profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
-  if (writer && !profiles_.empty())
-    writer->write_table("profiles", {"y", "phi", "u_x", "T"},
-                        {"d", "1", "P d eta-1", "P+2 d+2 eta-2"}, profiles_.table());
+  (void)writer;
 }
 
 }  // namespace sheardiff

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <fstream>
+#include <sstream>
+
+#include "sheardiff/io/atomic_file.hpp"
 
 namespace sheardiff {
 
@@ -210,7 +212,7 @@ void RunHealth::report(nlohmann::json& js) const {
 
 void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, const Velocities& v,
                       const HealthReport& r) {
-  std::ofstream out(file);
+  std::ostringstream out;
   out << "# sheardiff diagnostic frame: the state at which the run health check stopped the run\n"
       << "# problem: " << to_string(r.problem) << "\n# step: " << r.step
       << "\n# strain: " << fmt::format("{:.17g}", r.strain) << "\n# what: " << r.what
@@ -228,6 +230,7 @@ void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, cons
                        p.position[i].x(), p.position[i].y(), 2.0 * p.radius[i], u.x(), u.y(), u.z(),
                        static_cast<int>(p.motion[i]), flagged ? 1 : 0);
   }
+  write_file_atomically(file, out.str());
 }
 
 }  // namespace sheardiff

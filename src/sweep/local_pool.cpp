@@ -17,6 +17,8 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/io_error.hpp"
+#include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
@@ -33,7 +35,7 @@ class FileLock {
  public:
   FileLock(const fs::path& file, const std::string& what) {
     fd_ = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw std::runtime_error(fmt::format("cannot open {}", file.string()));
+    if (fd_ < 0) throw_io_error("open the lock file", file);
     if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       ::close(fd_);
       throw ConfigError(
@@ -56,11 +58,12 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_d
   const auto state = point_state(spec, p, out_dir);
   if (state == PointState::finished) return;
   const Config cfg = load_config(spec.base, p.overrides);
-  const auto dir = point_dir(out_dir, p);
   // A fresh point may hold the remains of a start killed before its first checkpoint: nothing
-  // in it can be continued, and a stale trajectory must not survive into the new run.
-  if (state == PointState::fresh) fs::remove_all(dir);
-  run_to_directory(cfg, dir, true, state == PointState::resumable);
+  // in it can be continued, and a stale trajectory must not survive into the new run
+  // (overwrite removes it, under the run directory's own lock).
+  RunDirectory dir(point_dir(out_dir, p), true);
+  run_to_directory(cfg, dir, state == PointState::resumable ? RunMode::resume : RunMode::overwrite,
+                   true);
   export_point(spec, p, out_dir);
 }
 

@@ -2,7 +2,9 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include "sheardiff/config.hpp"
@@ -23,7 +25,7 @@ std::string shell_quote(const std::string& s) {
 // Runs a command, returns its stdout; throws with its output when it fails.
 std::string run_command(const std::string& cmd) {
   FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (!pipe) throw std::runtime_error(fmt::format("cannot run: {}", cmd));
+  if (!pipe) throw std::runtime_error(fmt::format("cannot run {}: {}", cmd, std::strerror(errno)));
   std::string out;
   std::array<char, 4096> buf{};
   size_t n;

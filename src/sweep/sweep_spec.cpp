@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {
@@ -90,6 +92,10 @@ SweepSpec load_sweep(const fs::path& file) {
   if (!fs::exists(spec.base))
     throw ConfigError(
         fmt::format("{}.base = \"{}\": no such file ({})", w, base, spec.base.string()));
+  if (!fs::is_regular_file(spec.base))
+    throw ConfigError(
+        fmt::format("{}.base = \"{}\": {} is {}, not a config file", w, base, spec.base.string(),
+                    fs::is_directory(spec.base) ? "a directory" : "not a regular file"));
 
   if (const auto results = get_or<std::string>(*sweep, "results", "", w); !results.empty())
     spec.results = (fs::path(results).is_absolute() ? fs::path(results)
@@ -131,6 +137,16 @@ SweepSpec load_sweep(const fs::path& file) {
       throw ConfigError(fmt::format("{}: must be a non-empty list of values", where));
     std::vector<std::string> values;
     for (const auto& e : *arr) values.push_back(value_text(e, where));
+    // Two equal values (0.1 and 1e-1, or names that differ only in '_' and '-') would run one
+    // point twice, racing in one directory, and count it twice in sweep.csv and fits.json.
+    for (std::size_t i = 0; i < values.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (name_text(values[i]) == name_text(values[j]))
+          throw ConfigError(fmt::format(
+              "{}: entries {} and {} of the list are the same value ({}{}): a point would run "
+              "twice in one directory and count twice; remove one",
+              where, j + 1, i + 1, values[j],
+              values[i] == values[j] ? "" : " and " + values[i] + ", one directory name"));
     spec.axes.emplace_back(k, std::move(values));
   }
 
@@ -159,13 +175,23 @@ SweepSpec load_sweep(const fs::path& file) {
       }
   }
 
-  // Every point must be a valid run before any of them starts.
+  // Every point must be a valid run, and a run of its own, before any of them starts.
+  std::map<std::string, std::string> point_of_config;
   for (const auto& p : expand_points(spec)) {
+    Config cfg;
     try {
-      (void)point_config(spec, p);
+      cfg = point_config(spec, p);
+      validate_run_inputs(cfg, spec.base.string());
     } catch (const ConfigError& e) {
       throw ConfigError(fmt::format("{}: point {}: {}", origin, p.name, e.what()));
     }
+    const auto [it, fresh] = point_of_config.emplace(to_toml(cfg), p.name);
+    if (!fresh)
+      throw ConfigError(fmt::format(
+          "{}: points {} and {} run the same configuration (an axis value that changes nothing "
+          "once resolved): it would be computed twice and count twice in sweep.csv and "
+          "fits.json; remove one",
+          origin, it->second, p.name));
   }
   return spec;
 }

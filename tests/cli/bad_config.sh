@@ -13,6 +13,7 @@
 # Directives, read from the file's leading '#' comment lines:
 #   # expect: TEXT     fragment stderr must contain (one or more lines; at least one required)
 #   # set: KEY=VALUE   passed as --set KEY=VALUE (repeatable)
+#   # set-escaped: KEY=VALUE  the same, with printf escapes (\n) expanded first
 #   # origin: TEXT     the origin the message must name instead of the config path
 #   # path: REL        run on this path (relative to the case's folder) instead of the case,
 #                      e.g. a config file that does not exist
@@ -29,6 +30,7 @@ while IFS= read -r line; do
   case $line in
     "# expect: "*) expects+=("${line#\# expect: }") ;;
     "# set: "*) sets+=(--set "${line#\# set: }") ;;
+    "# set-escaped: "*) sets+=(--set "$(printf '%b' "${line#\# set-escaped: }")") ;;
     "# origin: "*) origin=${line#\# origin: } ;;
     "# path: "*) path="$case_dir/${line#\# path: }" ;;
   esac

@@ -122,7 +122,28 @@ def random_config(rng):
         "velocities": rng.random() < 0.7,
         "trajectory": rng.random() < 0.8,
     }
+    widen_cell(c)
     return c
+
+
+def widen_cell(c):
+    """Raises particles.N until the periodic cell is valid (validate_run_inputs: every periodic
+    edge above twice the neighbour cut-off of the largest pair); draws nothing from the random
+    stream, so the other cases stay as they were."""
+    p = c["particles"]
+    ratio = p["size_ratio"]
+    lub = c["lubrication"]
+    reach = 1.0 + 0.5 * lub["h_max"] if lub["enabled"] else 1.0
+    cutoff = 2.0 * 0.5 * max(1.0, ratio) * reach + c["neighbour"]["skin"]
+    small_per_large = {"area": ratio**2, "volume": ratio**3, "number": 1.0}[p["mix"]]
+    while True:
+        n_large = math.floor(p["N"] / (1.0 + small_per_large) + 0.5)
+        area = math.pi * 0.25 * ((p["N"] - n_large) + n_large * ratio**2)
+        lx = math.sqrt(area / p["phi_init"] / p["aspect"])
+        edge = lx if c["scene"]["type"] == "pressure_shear" else min(lx, p["aspect"] * lx)
+        if edge > 2.0 * cutoff * 1.001:
+            return
+        p["N"] += 5
 
 
 def to_toml(c):

@@ -8,9 +8,12 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
+#include <sstream>
 #include <thread>
 
+#include "sheardiff/core/archive.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/simulation.hpp"
 
@@ -52,8 +55,10 @@ contacts = true
   return file;
 }
 
-pid_t spawn(const fs::path& cfg, const fs::path& out, const std::vector<std::string>& extra = {}) {
-  std::vector<std::string> args = {binary().string(), "run", cfg.string(), "--out", out.string()};
+// `sheardiff run CFG ARGS...`, its stderr into `err` if given.
+pid_t spawn_run(const fs::path& cfg, const std::vector<std::string>& extra,
+                const fs::path& err = "/dev/null") {
+  std::vector<std::string> args = {binary().string(), "run", cfg.string()};
   args.insert(args.end(), extra.begin(), extra.end());
   const pid_t pid = fork();
   if (pid == 0) {
@@ -61,11 +66,20 @@ pid_t spawn(const fs::path& cfg, const fs::path& out, const std::vector<std::str
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
+    freopen(err.c_str(), "w", stderr);
     execv(argv[0], argv.data());
     _exit(127);
   }
   return pid;
+}
+pid_t spawn(const fs::path& cfg, const fs::path& out) {
+  return spawn_run(cfg, {"--out", out.string()});
+}
+pid_t spawn_resume(const fs::path& cfg, const fs::path& dir,
+                   const std::vector<std::string>& extra = {}, const fs::path& err = "/dev/null") {
+  std::vector<std::string> args = {"--resume", dir.string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return spawn_run(cfg, args, err);
 }
 
 int wait_exit(pid_t pid) {
@@ -74,7 +88,7 @@ int wait_exit(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-void expect_same_final_state(const fs::path& a, const fs::path& b) {
+void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_counters = true) {
   const H5mdFrame fa = read_h5md_frame(a / "trajectory.h5", -1);
   const H5mdFrame fb = read_h5md_frame(b / "trajectory.h5", -1);
   EXPECT_EQ(count_h5md_frames(a / "trajectory.h5"), count_h5md_frames(b / "trajectory.h5"));
@@ -101,6 +115,11 @@ void expect_same_final_state(const fs::path& a, const fs::path& b) {
   for (const char* key : {"steps", "strain", "phi", "mu", "H", "shear_stress", "max_overlap", "D",
                           "dv", "psi", "steady_strain", "pressure_max_relative_error"})
     EXPECT_EQ(sa[key], sb[key]) << key;
+  // The whole summary but the clock (issue 16: the solver's work counters, factorisations,
+  // restarted from 0 at a resume).
+  for (const char* clock : {"wall_seconds", "ms_per_step"}) sa.erase(clock), sb.erase(clock);
+  if (!with_counters) sa.erase("factorisations"), sb.erase("factorisations");
+  EXPECT_EQ(sa, sb);
   EXPECT_FALSE(fs::exists(b / "checkpoint.bin")) << "a finished run keeps no checkpoint";
 }
 
@@ -124,7 +143,7 @@ TEST(Checkpoint, SigkillAtRandomMomentThenResumeIsBitIdentical) {
   ASSERT_TRUE(fs::exists(root / "killed" / "checkpoint.bin"));
   EXPECT_FALSE(fs::exists(root / "killed" / "summary.json")) << "a killed run must not look finished";
 
-  ASSERT_EQ(wait_exit(spawn(cfg, root / "x", {"--resume", (root / "killed").string()})), 0);
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "killed")), 0);
   expect_same_final_state(root / "whole", root / "killed");
   fs::remove_all(root);
 }
@@ -143,7 +162,7 @@ TEST(Checkpoint, SigtermWritesCheckpointAndExitsCleanly) {
   if (code == 0) GTEST_SKIP() << "the run finished before SIGTERM landed";
   ASSERT_EQ(code, 128 + SIGTERM);
   ASSERT_TRUE(fs::exists(root / "stopped" / "checkpoint.bin"));
-  ASSERT_EQ(wait_exit(spawn(cfg, root / "x", {"--resume", (root / "stopped").string()})), 0);
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
   expect_same_final_state(root / "whole", root / "stopped");
   fs::remove_all(root);
 }
@@ -158,7 +177,144 @@ TEST(Checkpoint, ResumeRefusesAnotherConfiguration) {
   kill(pid, SIGKILL);
   wait_exit(pid);
   // Resuming with a different J is a configuration error (exit 2), not a silent mix.
-  EXPECT_EQ(wait_exit(spawn(cfg, root / "x", {"--resume", (root / "run").string(), "--set", "flow.J=0.1"})), 2);
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "run", {"--set", "flow.J=0.1"})), 2);
+  fs::remove_all(root);
+}
+
+std::vector<char> bytes_of(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::vector<char>(std::istreambuf_iterator<char>(in), {});
+}
+void write_bytes(const fs::path& f, const std::vector<char>& b) {
+  std::ofstream(f, std::ios::binary).write(b.data(), static_cast<std::streamsize>(b.size()));
+}
+std::string text_of(const fs::path& f) {
+  std::ifstream in(f);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// DIR stopped by SIGTERM at (or just after) its first periodic checkpoint.
+void make_interrupted_run(const fs::path& cfg, const fs::path& dir) {
+  const pid_t pid = spawn(cfg, dir);
+  for (int k = 0; k < 2000 && !fs::exists(dir / "checkpoint.bin"); ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(pid, SIGTERM);
+  ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+}
+
+// Issue 16: a flipped mantissa byte resumed to exit 0 with other results, a flipped exponent
+// was reported as "top wall escaped" (exit 4) and the checkpoint overwritten, a corrupt length
+// ended in std::bad_alloc without the file's name. Each must be named as corrupt (exit 2) and
+// the file left as it is.
+TEST(Checkpoint, CorruptCheckpointIsNamedNeverResumedNeverOverwritten) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_corrupt";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  make_interrupted_run(cfg, root / "run");
+  const std::vector<char> pristine = bytes_of(root / "run" / "checkpoint.bin");
+  // The first particle position follows the "dynamics" tag and the vector's length.
+  const std::string tag = "dynamics";
+  const auto at = std::search(pristine.begin(), pristine.end(), tag.begin(), tag.end());
+  ASSERT_NE(at, pristine.end());
+  const std::size_t x0 = static_cast<std::size_t>(at - pristine.begin()) + tag.size() + 8;
+  struct Case {
+    const char* name;
+    std::size_t offset;
+    char flip;
+  };
+  for (const Case& c : {Case{"mantissa", x0 + 2, 0x01}, Case{"exponent", x0 + 7, 0x10},
+                        Case{"length", 8 + 22, 0x01}}) {
+    SCOPED_TRACE(c.name);
+    const fs::path dir = root / c.name;
+    fs::copy(root / "run", dir, fs::copy_options::recursive);
+    std::vector<char> bad = pristine;
+    bad[c.offset] = static_cast<char>(bad[c.offset] ^ c.flip);
+    write_bytes(dir / "checkpoint.bin", bad);
+    EXPECT_EQ(wait_exit(spawn_resume(cfg, dir, {}, root / "err.txt")), 2);
+    const std::string err = text_of(root / "err.txt");
+    EXPECT_NE(err.find((dir / "checkpoint.bin").string() + " is corrupt"), std::string::npos)
+        << err;
+    EXPECT_EQ(bytes_of(dir / "checkpoint.bin"), bad) << "the checkpoint was changed";
+    EXPECT_FALSE(fs::exists(dir / "summary.json"));
+    EXPECT_FALSE(fs::exists(dir / "diagnostic.txt"));
+  }
+  fs::remove_all(root);
+}
+
+// A corrupt length field inside the state is bounded by what is left of the file.
+TEST(Checkpoint, ArchiveLengthsAreBoundedByTheFile) {
+  Archive w = Archive::writer();
+  std::vector<double> v{1.0, 2.0, 3.0};
+  w.io(v);
+  std::vector<char> bytes = w.bytes();
+  const std::uint64_t huge = std::uint64_t{1} << 50;
+  std::memcpy(bytes.data(), &huge, sizeof huge);
+  Archive r = Archive::reader(bytes);
+  std::vector<double> back;
+  try {
+    r.io(back);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("length field"), std::string::npos) << e.what();
+  }
+}
+
+// Checkpoints of sheardiff before issue 16 (version 2: no header, no checksum, no solver
+// counters) still resume, with a warning, to the same results.
+TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_v2";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
+  make_interrupted_run(cfg, root / "old");
+  const std::vector<char> v3 = bytes_of(root / "old" / "checkpoint.bin");
+  const std::size_t header = 8 + 22 + 8 + 4, counters = 4 * sizeof(std::size_t);
+  ASSERT_GT(v3.size(), header + counters);
+  std::vector<char> v2(8);
+  const std::uint64_t magic_length = 22;
+  std::memcpy(v2.data(), &magic_length, 8);
+  const std::string magic = "sheardiff-checkpoint-2";
+  v2.insert(v2.end(), magic.begin(), magic.end());
+  v2.insert(v2.end(), v3.begin() + header, v3.end() - counters);
+  write_bytes(root / "old" / "checkpoint.bin", v2);
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0);
+  EXPECT_NE(text_of(root / "err.txt").find("has no checksum"), std::string::npos);
+  expect_same_final_state(root / "whole", root / "old", /*with_counters=*/false);
+  fs::remove_all(root);
+}
+
+// Issue 16: SIGTERM while the initial packing was built killed the process (143) with no
+// checkpoint. It now waits for the set-up and checkpoints at step 0.
+TEST(Checkpoint, SigtermDuringSetUpWritesCheckpoint) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_setup_term";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const fs::path cfg = root / "slow_setup.toml";
+  // Compressing 1000 discs to phi = 0.8 takes seconds; the run itself 3 steps.
+  std::ofstream(cfg) << R"([scene]
+type = "simple_shear"
+[particles]
+N = 1000
+phi_init = 0.8
+[run]
+max_steps = 3
+[output]
+frame_strain = 0.01
+[analysis]
+diffusion = false
+)";
+  const pid_t pid = spawn(cfg, root / "run");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  kill(pid, SIGTERM);
+  ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
+  ASSERT_TRUE(fs::exists(root / "run" / "checkpoint.bin"));
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "run")), 0);
+  nlohmann::json js;
+  std::ifstream(root / "run" / "summary.json") >> js;
+  EXPECT_EQ(js["steps"], 3);
   fs::remove_all(root);
 }
 

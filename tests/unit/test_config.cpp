@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/simulation.hpp"
 
 namespace sheardiff {
 namespace {
@@ -215,8 +218,8 @@ TEST(Config, OutOfRangeValuesNameKeyAndRange) {
   const std::string j0 = config_error("[flow]\nJ = 0\n");
   EXPECT_CONTAINS(j0, "test.toml");
   EXPECT_CONTAINS(j0, "flow.J");
-  EXPECT_CONTAINS(j0, "(0, 10]");
-  EXPECT_CONTAINS(config_error("[flow]\nJ = 10.5\n"), "(0, 10]");
+  EXPECT_CONTAINS(j0, "[1e-10, 10]");
+  EXPECT_CONTAINS(config_error("[flow]\nJ = 10.5\n"), "[1e-10, 10]");
   // The boundaries themselves are accepted where closed.
   EXPECT_EQ(parse_config("[flow]\nJ = 10\n", "t").flow.j, 10.0);
   // particles.N is an integer in [2, 1e6].
@@ -282,10 +285,10 @@ TEST(Config, SetOverridesAreAppliedAndValidated) {
   EXPECT_CONTAINS(abc, "--set");
   EXPECT_CONTAINS(abc, "flow.J");
   EXPECT_CONTAINS(abc, "abc");
-  EXPECT_CONTAINS(abc, "(0, 10]");
+  EXPECT_CONTAINS(abc, "[1e-10, 10]");
   const std::string range = config_error(base, {"flow.J=0"});
   EXPECT_CONTAINS(range, "flow.J");
-  EXPECT_CONTAINS(range, "(0, 10]");
+  EXPECT_CONTAINS(range, "[1e-10, 10]");
   const std::string unknown = config_error(base, {"flow.j=1e-3"});
   EXPECT_CONTAINS(unknown, "--set");
   EXPECT_CONTAINS(unknown, "unknown key");
@@ -345,6 +348,83 @@ TEST(Config, OverlapChangeLimitFollowsTheStiffness) {
   EXPECT_DOUBLE_EQ(overlap_change_limit(c), 5e-4);
   EXPECT_CONTAINS(config_error("[integrator]\nmax_overlap_change = -1e-4\n"),
                   "integrator.max_overlap_change");
+}
+
+}  // namespace
+}  // namespace sheardiff
+
+namespace sheardiff {
+namespace {
+
+// Issue 16: a directory read as an empty config and ran the default scene; `check` of an empty
+// file printed the defaults.
+TEST(Config, ConfigFileMustBeAFileNamingItsScene) {
+  namespace fs = std::filesystem;
+  const auto dir = fs::temp_directory_path() / "sheardiff_config_file";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "dir.toml");
+  const auto error_of = [](const fs::path& f, std::vector<std::string> sets = {}) {
+    try {
+      load_config(f, sets);
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_CONTAINS(error_of(dir / "dir.toml"), "it is a directory, not a TOML file");
+  EXPECT_CONTAINS(error_of(dir / "missing.toml"), "cannot open the config file: No such file");
+  std::ofstream(dir / "empty.toml") << "";
+  EXPECT_CONTAINS(error_of(dir / "empty.toml"), "empty.toml: scene.type: missing");
+  std::ofstream(dir / "flow.toml") << "# a comment\n[flow]\nJ = 1e-3\n";
+  EXPECT_CONTAINS(error_of(dir / "flow.toml"), "scene.type: missing");
+  EXPECT_EQ(error_of(dir / "flow.toml", {"scene.type=simple_shear"}), "");
+  std::ofstream(dir / "scene.toml") << "[scene]\ntype = \"pressure_shear\"\n";
+  EXPECT_EQ(load_config(dir / "scene.toml").scene.type, "pressure_shear");
+  fs::remove_all(dir);
+}
+
+// Issue 16: frame_strain (or checkpoint_strain) = 1e-300 was in range and spun forever.
+TEST(Config, OutputSpacingsAreBoundedByTheRunStrain) {
+  const std::string frames = config_error("[output]\nframe_strain = 1e-300\n");
+  EXPECT_CONTAINS(frames, "output.frame_strain: 1e-300 asks for run.strain / output.frame_strain");
+  EXPECT_CONTAINS(frames, "at most 1e+07 are allowed, i.e. output.frame_strain >= 1e-07");
+  EXPECT_CONTAINS(config_error("[output]\ncheckpoint_strain = 1e-300\n"),
+                  "output.checkpoint_strain >= 1e-07");
+  EXPECT_CONTAINS(config_error("[run]\nstrain = 2.0\n[output]\nframe_strain = 1e-7\n"),
+                  "output.frame_strain >= 2e-07");
+  EXPECT_EQ(parse_config("[output]\nframe_strain = 1e-7\ncheckpoint_strain = 1e-7\n", "t")
+                .output.frame_strain,
+            1e-7);
+  EXPECT_EQ(parse_config("[output]\ncheckpoint_strain = 0\n", "t").output.checkpoint_strain, 0.0);
+}
+
+// Issue 16: J = 1e-300 and delta = 1e-300 failed in the solve with advice about
+// max_displacement.
+TEST(Config, TinyJAndDeltaAreOutOfRange) {
+  EXPECT_CONTAINS(config_error("[flow]\nJ = 1e-300\n"), "expected a number in [1e-10, 10]");
+  EXPECT_CONTAINS(config_error("[lubrication]\ndelta = 1e-300\n"),
+                  "expected a number in [1e-10, 0.5]");
+  EXPECT_EQ(parse_config("[flow]\nJ = 1e-10\n", "t").flow.j, 1e-10);
+}
+
+// Issue 16: TOML read the text after a line break in a --set value as further keys.
+TEST(Config, SetValueWithALineBreakIsRefused) {
+  const std::string e = config_error("", {"flow.J=1e-2\nrun.strain=5"});
+  EXPECT_CONTAINS(e, "--set flow.J=1e-2: the value holds a line break");
+}
+
+// The frame catch-up advances as repeated addition does, and ends whatever the spacing.
+TEST(Config, NextOutputStrainEndsForAnySpacing) {
+  double next = 0.02;
+  for (const double strain : {0.0199999999999, 0.05, 0.0601, 0.3}) {
+    double expected = next;
+    while (expected <= strain * (1.0 + 1e-12)) expected += 0.02;
+    next = next_output_strain(next, 0.02, strain);
+    EXPECT_EQ(next, expected) << strain;
+  }
+  EXPECT_GT(next_output_strain(1e-300, 1e-300, 1.0), 1.0);
+  EXPECT_GT(next_output_strain(0.5, 1e-20, 1.0), 1.0);
+  EXPECT_LT(next_output_strain(0.5, 1e-20, 1.0), 1.0 + 1e-11);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // Sweep files, points and fits (the processes and Slurm are tested by tests/sweep/*.sh).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -97,6 +98,40 @@ TEST(Sweep, BadSweepFilesNameTheKey) {
                                  "\"flow.J\" = [0.1]\n[slurm]\nthrotle = 2\n"))
                 .find("unknown key 'throtle'"),
             std::string::npos);
+}
+
+// Issue 16: equal axis values raced in one directory and counted twice in the fits; a
+// directory as the base config ran the default scene.
+TEST(Sweep, DuplicatePointsAndDirectoryBaseAreRefused) {
+  EXPECT_NE(
+      error_of(write_files("dupj",
+                           "[sweep]\nbase = \"base.toml\"\n"
+                           "[sweep.axes]\n\"flow.J\" = [0.1, 0.01, 1e-1]\n"))
+          .find("sweep.axes.\"flow.J\": entries 1 and 3 of the list are the same value (0.1)"),
+      std::string::npos);
+  EXPECT_NE(error_of(write_files("dupseed",
+                                 "[sweep]\nbase = \"base.toml\"\n"
+                                 "[sweep.axes]\n\"flow.J\" = [0.1]\n\"run.seed\" = [1, 1]\n"))
+                .find("sweep.axes.\"run.seed\": entries 1 and 2"),
+            std::string::npos);
+  // Different values, one directory name.
+  EXPECT_NE(error_of(write_files("dupname",
+                                 "[sweep]\nbase = \"base.toml\"\n"
+                                 "[sweep.axes]\n\"particles.init_file\" = [\"a_b\", \"a-b\"]\n"))
+                .find("one directory name"),
+            std::string::npos);
+  // Different values, one configuration once the defaults are resolved.
+  const std::string frame = fmt::format("{}", 0.035 * std::pow(0.1, 0.25));
+  const auto e = error_of(write_files("dupconfig",
+                                      "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
+                                      "\"flow.J\" = 0.1\n[sweep.axes]\n"
+                                      "\"output.frame_strain\" = [0.0, " +
+                                          frame + "]\n"));
+  EXPECT_NE(e.find("run the same configuration"), std::string::npos) << e;
+  const auto dir =
+      write_files("dirbase", "[sweep]\nbase = \"folder\"\n[sweep.axes]\n\"flow.J\" = [0.1]\n");
+  fs::create_directories(dir.parent_path() / "folder");
+  EXPECT_NE(error_of(dir).find("is a directory, not a config file"), std::string::npos);
 }
 
 TEST(Sweep, FreshAndForeignPointDirectories) {

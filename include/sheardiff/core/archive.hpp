@@ -31,7 +31,12 @@ class Archive {
   void io(std::vector<T>& v) {
     std::uint64_t n = v.size();
     io(n);
-    if (loading_) v.resize(n);
+    // Each element takes at least one byte (its size if trivially copyable): a length beyond
+    // what is left is a corrupt file, not a reason to allocate.
+    if (loading_) {
+      check_length(n, std::is_trivially_copyable_v<T> ? sizeof(T) : 1);
+      v.resize(n);
+    }
     if constexpr (std::is_trivially_copyable_v<T>) {
       raw(v.data(), n * sizeof(T));
     } else {
@@ -51,7 +56,10 @@ class Archive {
   void io(std::string& s) {
     std::uint64_t n = s.size();
     io(n);
-    if (loading_) s.resize(n);
+    if (loading_) {
+      check_length(n, 1);
+      s.resize(n);
+    }
     raw(s.data(), n);
   }
   template <class T>
@@ -69,6 +77,12 @@ class Archive {
 
  private:
   Archive(bool loading, std::vector<char> bytes) : loading_(loading), buf_(std::move(bytes)) {}
+  void check_length(std::uint64_t n, std::size_t bytes_each) const {
+    if (n > (buf_.size() - pos_) / bytes_each)
+      throw std::runtime_error("checkpoint: a length field of " + std::to_string(n) +
+                               " elements exceeds the " + std::to_string(buf_.size() - pos_) +
+                               " bytes left in the file");
+  }
   void raw(void* p, std::size_t n) {
     if (n == 0) return;  // an empty vector's data() may be null: memcpy(null, ...) is UB
     if (loading_) {

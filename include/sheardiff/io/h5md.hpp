@@ -1,6 +1,7 @@
 #pragma once
 // H5MD 1.1 trajectory output/input (HDF5 C API kept out of this header) and the plain-text
-// position table reader. All errors are std::runtime_error naming the file and the object.
+// position table reader. All errors are IoError (a std::runtime_error) naming the file, the
+// object and, where HDF5 recorded one, the operating system's reason.
 #include <Eigen/Core>
 #include <array>
 #include <cstddef>
@@ -73,7 +74,8 @@ class H5mdWriter {
   // Appends one row to every time-dependent dataset. Validates all inputs before writing.
   void write_frame(const FrameData& frame);
   // Time-independent table: one time-independent element /observables/<name>/<column> of
-  // shape (rows) per column, each with its H5MD unit string. The name must not already exist.
+  // shape (rows) per column, each with its H5MD unit string; a table of that name is replaced
+  // (the end of a run may be repeated after a kill).
   void write_table(const std::string& name, const std::vector<std::string>& columns,
                    const std::vector<std::string>& units, const Eigen::MatrixXd& values);
   void flush();

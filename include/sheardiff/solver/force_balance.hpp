@@ -81,6 +81,7 @@ class ForceBalance {
 
   const std::vector<PairTerm>& terms() const { return terms_; }
   const ResistanceSystem& system() const { return system_; }
+  ResistanceSystem& system() { return system_; }
   // Most low-rank terms per factorisation before a re-solve refactorises (0: from the
   // factorisation's flop count, the default).
   void set_max_low_rank_terms(std::size_t n) { system_.set_max_low_rank_terms(n); }

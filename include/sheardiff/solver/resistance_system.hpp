@@ -69,6 +69,10 @@ class ResistanceSystem {
   double wall_rhs() const { return wall_rhs_; }
   std::size_t factorisations() const { return factorisations_; }
   std::size_t analyses() const { return analyses_; }
+  // The work counters, for checkpoints: a resumed run's summary reports the whole run's.
+  void serialize_counters(Archive& a) {
+    a.io(factorisations_), a.io(analyses_), a.io(low_rank_solves_), a.io(low_rank_terms_);
+  }
 
  private:
   int index(int row, int col) const;

@@ -40,7 +40,8 @@ struct SweepPoint {
 };
 
 // Reads and checks the sweep file, then builds and validates every point's config before any
-// work starts. Throws ConfigError naming the file and key.
+// work starts (validate_run_inputs included); two equal values of an axis, or two points with
+// one resolved config, are refused. Throws ConfigError naming the file and key.
 SweepSpec load_sweep(const std::filesystem::path& file);
 // Whether a TOML file is a sweep file (has a [sweep] table): `sheardiff check` takes both.
 bool is_sweep_file(const std::filesystem::path& file);
@@ -54,13 +55,14 @@ enum class PointState { finished, resumable, fresh };
 PointState point_state(const SweepSpec& spec, const SweepPoint& p,
                        const std::filesystem::path& out_dir);
 
-// Runs one point to its end in this process (resuming or starting afresh as its state says).
+// Runs one point to its end in this process (resuming, or starting afresh over the remains of
+// a start killed before its first checkpoint, as its state says), in its run directory's lock.
 // Throws what run_to_directory throws.
 void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
 
 // Local backend: `jobs` worker processes of `exe sweep FILE --out DIR --point I`, a progress
 // line on stderr, SIGINT/SIGTERM forwarded (workers checkpoint). Returns the number of failed
-// points; throws RunInterrupted-like std::runtime_error on a signal.
+// points (the command then exits 3); throws RunInterrupted on a signal.
 int run_local(const SweepSpec& spec, const std::filesystem::path& out_dir, int jobs,
               const std::filesystem::path& exe);
 
