@@ -1,44 +1,50 @@
 #!/usr/bin/python3
-"""Draw the seed paper's panels from a finished sweep (DIR/sweep.csv, DIR/fits.json and each
-point's analysis.h5), one series per ktilde (and N), the seed's power law drawn dashed:
+"""Draw the seed paper's figures 1c/d, 2a/b and 3a/b/c from a sweep, with error bars, from its
+fits.json, sweep.csv and each point's analysis.h5 alone (a sweep folder, or the committed store
+results/<name>/ that `sheardiff sweep ... --collect` writes). One series per group (ktilde, N,
+...); error bars are the standard error of the mean over seeds (the seeds' scatter; where a J has
+one seed, the run's own error bar, drawn with open caps); fits are drawn over the measured range
+only; the seed's laws dashed black.
 
-  (a) MSD in the gradient direction against strain, all J     (seed fig. 1c)
-  (b) the same against t / Psi                                (seed fig. 1c inset)
-  (c) D / (gammadot d^2) against J                            (seed fig. 1d)
-  (d) phi against J                                           (seed fig. 2a)
-  (e) phi_c - phi against J, with the fitted law              (seed fig. 2a inset)
-  (f) D against phi_c - phi                                   (seed fig. 2b)
-  (g) dv / (gammadot d) and Psi gammadot against J            (seed fig. 3a)
-  (h) mu against J
+  (a) MSD in the gradient direction against strain, fit window shaded   (seed fig. 1c)
+  (b) the same against t / Psi                                          (fig. 1c inset)
+  (c) D / (gammadot d^2) against J                                      (fig. 1d)
+  (d) phi against J, with phi_c - phi against J inset                  (fig. 2a)
+  (e) D against phi_c - phi                                             (fig. 2b)
+  (f) dv / (gammadot d) and Psi gammadot against J                      (fig. 3a)
+  (g) the same against phi_c - phi                                      (fig. 3b)
+  (h) step length dv Psi / d against phi_c - phi                        (fig. 3c)
+  (i) mu against J with mu_c + a J^b
+  (j) D / (dv^2 Psi) for each Psi definition: which one makes D = dv^2 Psi hold
 
-    /usr/bin/python3 tools/plot_sweep.py SWEEP_DIR [--out SWEEP_DIR/sweep.png]
+    /usr/bin/python3 tools/plot_sweep.py DIR [--out DIR/sweep.png]
 """
 import argparse
 import csv
 import json
 import math
 import pathlib
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-try:
-    import h5py
-except ImportError:  # the MSD panels need it; the others do not
-    h5py = None
+import sys
 
 SEED = {  # seed Table 1 (suspensions) and eq. (3.3)
     "D": (0.024, -0.26), "dv": (0.258, -0.25), "psi": (0.35, 0.24),
-    "D_phi": (0.019, -0.61), "phi_c": 0.81, "phi_a": 0.64, "phi_b": 0.5,
+    "D_phi": (0.019, -0.61), "dv_phi": (0.25, -0.54), "psi_phi": (0.37, 0.51),
+    "phi_c": 0.81, "phi_a": 0.64, "phi_b": 0.5, "step": 0.09,
 }
+CLOSE_PACKING_2D = 0.9069
 
 
 def series_label(axes):
     return ", ".join(f"{k.split('.')[-1]} = {v:g}" if isinstance(v, (int, float)) else f"{k}={v}"
                      for k, v in axes.items()) or "all points"
+
+
+def num(r, k):
+    v = r.get(k)
+    try:
+        return float(v) if v not in (None, "") else math.nan
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def main():
@@ -47,90 +53,176 @@ def main():
     ap.add_argument("sweep", type=pathlib.Path)
     ap.add_argument("--out", type=pathlib.Path)
     args = ap.parse_args()
+    for f in ("fits.json", "sweep.csv"):
+        if not (args.sweep / f).exists():
+            sys.exit(f"{args.sweep}: no {f} (run `sheardiff sweep SWEEP.toml --out DIR --collect` "
+                     f"first)")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    try:
+        import h5py
+    except ImportError:
+        h5py = None
+        print("warning: no h5py: the MSD panels are left empty", file=sys.stderr)
+
     fits = json.loads((args.sweep / "fits.json").read_text())
     rows = [r for r in csv.DictReader(open(args.sweep / "sweep.csv")) if r["status"] == "done"]
-
-    fig, ax = plt.subplots(2, 4, figsize=(18, 8.5))
+    fig, ax = plt.subplots(3, 4, figsize=(19, 13))
     ax = ax.ravel()
-    jgrid = np.logspace(-4.2, 0, 50)
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     markers = "osD^v<>"
 
-    # (a), (b): MSD curves of every finished point, coloured by J.
-    if h5py is not None:
-        js = sorted({float(r["J"]) for r in rows})
-        cmap = plt.get_cmap("viridis")
+    # (a), (b): every finished point's MSD, coloured by J.
+    js = sorted({num(r, "J") for r in rows})
+    cmap = plt.get_cmap("viridis")
+    window = None
+    if h5py is not None and js:
         for r in rows:
             f = args.sweep / "points" / r["point"] / "analysis.h5"
             if not f.exists():
                 continue
             with h5py.File(f, "r") as h:
                 lag, msd = h["msd/lag"][()], h["msd/msd"][()]
+                window = (h.attrs.get("msd_window_lo"), h.attrs.get("msd_window_hi"))
             ok = lag > 0
-            c = cmap(js.index(float(r["J"])) / max(len(js) - 1, 1))
-            ax[0].loglog(lag[ok], msd[ok], color=c, lw=1)
-            psi = float(r["psi"]) if r.get("psi") else math.nan
+            c = cmap(js.index(num(r, "J")) / max(len(js) - 1, 1))
+            ax[0].loglog(lag[ok], msd[ok], color=c, lw=0.8)
+            psi = num(r, "psi")
             if psi > 0:
-                ax[1].loglog(lag[ok] / psi, msd[ok], color=c, lw=1)
+                ax[1].loglog(lag[ok] / psi, msd[ok], color=c, lw=0.8)
         sm = plt.cm.ScalarMappable(cmap=cmap, norm=matplotlib.colors.LogNorm(min(js), max(js)))
-        fig.colorbar(sm, ax=ax[1], label="J")
+        fig.colorbar(sm, ax=ax[0], label="J")
+        if window and window[0] is not None:
+            ax[0].axvspan(window[0], window[1], color="0.9", zorder=0, label="fit window")
+            ax[0].legend(fontsize=7)
     ax[0].set(xlabel=r"strain $\dot\gamma t$", ylabel=r"$\langle\Delta y^2\rangle / d^2$",
-              title="(a) MSD, gradient direction")
+              title="(a) MSD, gradient direction (fig. 1c)")
     ax[1].set(xlabel=r"$t / \Psi$", ylabel=r"$\langle\Delta y^2\rangle / d^2$",
-              title="(b) MSD against t / Psi")
+              title="(b) MSD against t / Psi (fig. 1c inset)")
+    inset = ax[3].inset_axes([0.58, 0.55, 0.38, 0.38])
+
+    def errbar(a, x, y, e, e_open, c, m, label):
+        """Seed-scatter error bars filled; run-own error bars (one seed) open."""
+        has_sem = ~np.isnan(e)
+        if has_sem.any():
+            a.errorbar(x[has_sem], y[has_sem], yerr=e[has_sem], fmt=m, color=c, ms=5, capsize=3,
+                       label=label)
+        if (~has_sem).any():
+            a.errorbar(x[~has_sem], y[~has_sem], yerr=e_open[~has_sem], fmt=m, color=c, mfc="none",
+                       ms=5, capsize=2, label=None if has_sem.any() else label)
+
+    def line(a, xs, f, c, fmt_label):
+        if "a" not in f:
+            return
+        x = np.logspace(np.log10(np.nanmin(xs)), np.log10(np.nanmax(xs)), 40)
+        a.loglog(x, f["a"] * x ** f["b"], "-", color=c, lw=0.9, label=fmt_label.format(**f))
 
     for gi, g in enumerate(fits["groups"]):
         c, m = colours[gi % len(colours)], markers[gi % len(markers)]
         lab = series_label(g["axes"])
         rr = sorted(g["rows"], key=lambda r: r["J"])
         J = np.array([r["J"] for r in rr])
-        get = lambda k: np.array([r.get(k) if r.get(k) is not None else np.nan for r in rr])  # noqa
+
+        def get(k):
+            return np.array([r.get(k) if r.get(k) is not None else np.nan for r in rr], float)
+
         f = g["fits"]
-        ax[2].loglog(J, get("D"), m, color=c, label=lab)
-        if "a" in f["D_vs_J"]:
-            ax[2].loglog(jgrid, f["D_vs_J"]["a"] * jgrid ** f["D_vs_J"]["b"], "-", color=c, lw=0.8,
-                         label=f"fit: {f['D_vs_J']['a']:.3g} J^{f['D_vs_J']['b']:.2f}")
-        ax[3].semilogx(J, get("phi"), m, color=c, label=lab)
+        errbar(ax[2], J, get("D"), get("D_sem"), get("D_run_err"), c, m, lab)
+        line(ax[2], J, f["D_vs_J"], c, "fit: {a:.3g} J^{b:.2f}")
+        errbar(ax[3], J, get("phi"), get("phi_sem"), get("phi_run_err"), c, m, lab)
         pf = f["phi_of_J"]
+        x = None
         if "phi_c" in pf:
-            ax[3].semilogx(jgrid, pf["phi_c"] - pf["a"] * jgrid ** pf["b"], "-", color=c, lw=0.8,
+            if pf["phi_c"] > CLOSE_PACKING_2D:
+                print(f"warning: {lab}: fitted phi_c = {pf['phi_c']:.3f} is above the 2D close "
+                      f"packing {CLOSE_PACKING_2D}: the dilatancy fit is unphysical",
+                      file=sys.stderr)
+            jj = np.logspace(np.log10(J.min()), np.log10(J.max()), 40)
+            ax[3].semilogx(jj, pf["phi_c"] - pf["a"] * jj ** pf["b"], "-", color=c, lw=0.9,
                            label=f"fit: {pf['phi_c']:.3f} - {pf['a']:.2f} J^{pf['b']:.2f}")
             x = pf["phi_c"] - get("phi")
-            ax[4].loglog(J, x, m, color=c, label=lab)
-            ax[4].loglog(jgrid, pf["a"] * jgrid ** pf["b"], "-", color=c, lw=0.8)
-            ax[5].loglog(x, get("D"), m, color=c, label=lab)
-            if "a" in f["D_vs_phic_minus_phi"]:
-                xs = np.logspace(-3, 0, 40)
-                fd = f["D_vs_phic_minus_phi"]
-                ax[5].loglog(xs, fd["a"] * xs ** fd["b"], "-", color=c, lw=0.8,
-                             label=f"fit: {fd['a']:.3g} x^{fd['b']:.2f}")
-        ax[6].loglog(J, get("dv"), m, color=c, label=f"dv, {lab}")
-        ax[6].loglog(J, get("psi"), m, color=c, mfc="none", label=f"Psi, {lab}")
-        ax[7].semilogx(J, get("mu"), m, color=c, label=lab)
+            inset.loglog(J, x, m, color=c, ms=4)
+            inset.loglog(jj, pf["a"] * jj ** pf["b"], "-", color=c, lw=0.8)
+            errbar(ax[4], x, get("D"), get("D_sem"), get("D_run_err"), c, m, lab)
+            line(ax[4], x, f["D_vs_phic_minus_phi"], c, "fit: {a:.3g} x^{b:.2f}")
+        errbar(ax[5], J, get("dv"), get("dv_sem"), get("dv_run_err"), c, m, f"dv, {lab}")
+        line(ax[5], J, f["dv_vs_J"], c, "{a:.3g} J^{b:.2f}")
+        errbar(ax[5], J, get("psi"), get("psi_sem"), get("psi_run_err"), c, "^", f"Psi, {lab}")
+        line(ax[5], J, f["psi_vs_J"], c, "{a:.3g} J^{b:.2f}")
+        if x is not None:
+            errbar(ax[6], x, get("dv"), get("dv_sem"), get("dv_run_err"), c, m, f"dv, {lab}")
+            errbar(ax[6], x, get("psi"), get("psi_sem"), get("psi_run_err"), c, "^", f"Psi, {lab}")
+            line(ax[6], x, f["dv_vs_phic_minus_phi"], c, "{a:.3g} x^{b:.2f}")
+            line(ax[6], x, f["psi_vs_phic_minus_phi"], c, "{a:.3g} x^{b:.2f}")
+        errbar(ax[8], J, get("mu"), get("mu_sem"), get("mu_run_err"), c, m, lab)
+        mf = f["mu_of_J"]
+        if "mu_c" in mf:
+            jj = np.logspace(np.log10(J.min()), np.log10(J.max()), 40)
+            ax[8].semilogx(jj, mf["mu_c"] + mf["a"] * jj ** mf["b"], "-", color=c, lw=0.9,
+                           label=f"fit: {mf['mu_c']:.3f} + {mf['a']:.2f} J^{mf['b']:.2f}")
 
+    # Per-point panels from sweep.csv: step length and the Psi definitions.
+    pts = {}
+    for r in rows:
+        pts.setdefault(num(r, "J"), []).append(r)
+    phic = next((g["fits"]["phi_of_J"].get("phi_c") for g in fits["groups"]), None)
+    for k, (key, style, lab) in enumerate((("psi", "o", "integral to first zero (psi)"),
+                                           ("psi_e", "s", "1/e time (psi_e)"),
+                                           ("psi_full", "D", "full integral (psi_full)"),
+                                           ("psi_zero", "v", "first zero crossing (psi_zero)"))):
+        xs, ys = [], []
+        for j, rs in pts.items():
+            for r in rs:
+                v = num(r, "D") / (num(r, "dv") ** 2 * num(r, key))
+                if math.isfinite(v):
+                    xs.append(j), ys.append(v)
+        if xs:
+            ax[9].semilogx(xs, ys, style, mfc="none", color=colours[k], label=lab)
+    if phic is not None:
+        for j, rs in pts.items():
+            for r in rs:
+                ax[7].loglog(phic - num(r, "phi"), num(r, "dv") * num(r, "psi"), "o",
+                             color=colours[0], mfc="none", ms=5)
+    ax[9].axhline(1.0, color="k", lw=0.8)
+
+    jg = np.logspace(-4, -1, 40)
     a, b = SEED["D"]
-    ax[2].loglog(jgrid, a * jgrid ** b, "k--", label=f"seed: {a} J^{b}")
-    ax[3].semilogx(jgrid, SEED["phi_c"] - SEED["phi_a"] * jgrid ** SEED["phi_b"], "k--",
+    ax[2].loglog(jg, a * jg ** b, "k--", label=f"seed: {a} J^{b}")
+    ax[3].semilogx(jg, SEED["phi_c"] - SEED["phi_a"] * jg ** SEED["phi_b"], "k--",
                    label="seed: 0.81 - 0.64 J^0.5")
-    ax[4].loglog(jgrid, SEED["phi_a"] * jgrid ** SEED["phi_b"], "k--", label="seed: 0.64 J^0.5")
-    xs = np.logspace(-3, 0, 40)
-    ax[5].loglog(xs, SEED["D_phi"][0] * xs ** SEED["D_phi"][1], "k--", label="seed: 0.019 x^-0.61")
-    for k, style in (("dv", "k--"), ("psi", "k:")):
-        a, b = SEED[k]
-        ax[6].loglog(jgrid, a * jgrid ** b, style, label=f"seed {k}: {a} J^{b}")
-    ax[2].set(xlabel="J", ylabel=r"$D / \dot\gamma d^2$", title="(c) diffusion coefficient")
-    ax[3].set(xlabel="J", ylabel=r"$\phi$", title="(d) dilatancy")
-    ax[4].set(xlabel="J", ylabel=r"$\phi_c - \phi$", title=r"(e) $\phi_c - \phi$ (fitted $\phi_c$)")
-    ax[5].set(xlabel=r"$\phi_c - \phi$", ylabel=r"$D / \dot\gamma d^2$", title="(f) D against distance to jamming")
-    ax[6].set(xlabel="J", ylabel=r"$\delta v/\dot\gamma d$ (filled), $\Psi\dot\gamma$ (open)",
-              title="(g) fluctuations and persistence")
-    ax[7].set(xlabel="J", ylabel=r"$\mu = \tau / P$", title="(h) effective friction")
-    for a_ in ax[2:]:
-        a_.legend(fontsize=7)
-    fig.suptitle(f"{args.sweep}: {fits['finished']}/{fits['points']} points")
+    inset.loglog(jg, SEED["phi_a"] * jg ** SEED["phi_b"], "k--")
+    inset.set(xlabel="J", ylabel=r"$\phi_c-\phi$")
+    xg = np.logspace(np.log10(0.02), np.log10(0.25), 40)
+    ax[4].loglog(xg, SEED["D_phi"][0] * xg ** SEED["D_phi"][1], "k--", label="seed: 0.019 x^-0.61")
+    for key, style in (("dv", "k--"), ("psi", "k:")):
+        a, b = SEED[key]
+        ax[5].loglog(jg, a * jg ** b, style, label=f"seed {key}: {a} J^{b}")
+        a, b = SEED[key + "_phi"]
+        ax[6].loglog(xg, a * xg ** b, style, label=f"seed {key}: {a} x^{b}")
+    ax[7].axhline(SEED["step"], color="k", ls="--", label="seed: 0.09 d")
+    ax[2].set(xlabel="J", ylabel=r"$D / \dot\gamma d^2$", title="(c) diffusion coefficient (fig. 1d)")
+    ax[3].set(xlabel="J", ylabel=r"$\phi$", title="(d) dilatancy (fig. 2a)")
+    ax[4].set(xlabel=r"$\phi_c - \phi$", ylabel=r"$D / \dot\gamma d^2$", title="(e) D against distance to jamming (fig. 2b)")
+    ax[5].set(xlabel="J", ylabel=r"$\delta v/\dot\gamma d$, $\Psi\dot\gamma$ (triangles)",
+              title="(f) fluctuations and persistence (fig. 3a)")
+    ax[6].set(xlabel=r"$\phi_c - \phi$", ylabel=r"$\delta v/\dot\gamma d$, $\Psi\dot\gamma$ (triangles)",
+              title="(g) the same against phi_c - phi (fig. 3b)")
+    ax[7].set(xlabel=r"$\phi_c - \phi$", ylabel=r"$\ell / d = \delta v \Psi / d$",
+              title="(h) step length, every run (fig. 3c)")
+    ax[8].set(xlabel="J", ylabel=r"$\mu = \tau / P$", title="(i) effective friction")
+    ax[9].set(xlabel="J", ylabel=r"$D / (\delta v^2 \Psi)$", title="(j) D = dv^2 Psi for each Psi definition")
+    ax[10].axis("off")
+    ax[11].axis("off")
+    for a_ in ax[2:10]:
+        if a_.get_legend_handles_labels()[0]:
+            a_.legend(fontsize=7, loc="lower left" if a_ is ax[3] else "best")
+    fig.suptitle(f"{args.sweep}: {fits['finished']}/{fits['points']} points; error bars: standard "
+                 "error over seeds (open: one run's own error)")
     fig.tight_layout()
     out = args.out or args.sweep / "sweep.png"
-    fig.savefig(out, dpi=110)
+    fig.savefig(out, dpi=100)
     print(out)
 
 

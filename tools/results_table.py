@@ -1,74 +1,104 @@
 #!/usr/bin/python3
-"""Markdown tables of a finished sweep for docs/results.md: per group (ktilde, N, ...) the
-measured points (J, phi, mu, D, dv, Psi, steps per strain, wall time) and the fitted laws side
-by side with the seed's Table 1 and eq. (3.3).
+"""Markdown tables of a sweep for docs/results.md, from its fits.json and sweep.csv alone (a
+sweep folder, or the committed store results/<name>/ that `sheardiff sweep ... --collect`
+writes). Per group (ktilde, N, ...):
 
-    /usr/bin/python3 tools/results_table.py SWEEP_DIR
+  * every J: the mean over seeds of phi, mu, D, dv, Psi with the standard error of that mean
+    from the seeds' scatter (n seeds), and what the runs' own error bars predict for it;
+  * the seed paper's Table 1 side by side, row by row: our a, b with errors from a bootstrap
+    over seeds, the seed's, and the verdict (difference in combined standard errors).
+
+    /usr/bin/python3 tools/results_table.py DIR
 """
 import csv
 import json
+import math
 import pathlib
 import sys
 
 
 def fmt(x, p=3):
-    return "-" if x is None else f"{x:.{p}g}"
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{p}g}"
 
 
-def law(f, seed=None):
+def pm(x, e, p=3):
+    if x is None:
+        return "-"
+    return f"{x:.{p}g}" + (f" +- {e:.2g}" if e is not None else "")
+
+
+def verdict(x, e, ref, ref_e):
+    """How many combined standard errors apart; 'agrees' within 2."""
+    if x is None or e is None:
+        return "no error bar (one seed)"
+    s = math.hypot(e, ref_e or 0.0)
+    z = abs(x - ref) / s if s > 0 else math.inf
+    return f"agrees ({z:.1f} sigma)" if z <= 2 else f"differs ({z:.1f} sigma)"
+
+
+def law(f):
     if "error" in f:
         return f"not fitted ({f['error']})"
-    s = f"{f['a']:.3g} +- {f['a_stderr']:.1g}, {f['b']:+.3f} +- {f['b_stderr']:.3f}"
-    return s
+    return f"{pm(f['a'], f.get('a_stderr'))}, {f['b']:+.3f}" + (
+        f" +- {f['b_stderr']:.3f}" if f.get("b_stderr") is not None else "")
 
 
 def main():
+    if len(sys.argv) != 2:
+        sys.exit(f"usage: {sys.argv[0]} DIR (a sweep folder or results/<name>)")
     out = pathlib.Path(sys.argv[1])
+    if not (out / "fits.json").exists() or not (out / "sweep.csv").exists():
+        sys.exit(f"{out}: no fits.json / sweep.csv (run `sheardiff sweep SWEEP.toml --out DIR "
+                 f"--collect` first)")
     fits = json.loads((out / "fits.json").read_text())
     rows = list(csv.DictReader(open(out / "sweep.csv")))
     seed = fits["seed_table1"]
-    total_wall = sum(float(r["wall_seconds"]) for r in rows if r.get("wall_seconds"))
-    print(f"{fits['finished']} of {fits['points']} points finished; "
-          f"summed run wall time {total_wall / 3600:.2f} h.\n")
+    done = [r for r in rows if r["status"].startswith("done")]
+    cpu = sum(float(r["wall_seconds"]) for r in done if r.get("wall_seconds"))
+    print(f"{fits['finished']} of {fits['points']} points finished; summed run time "
+          f"{cpu / 3600:.2f} h.\n")
     for g in fits["groups"]:
         axes = ", ".join(f"{k} = {v}" for k, v in g["axes"].items()) or "all points"
         print(f"#### {axes}\n")
-        print("| J | phi | mu | D / (gammadot d^2) | dv / (gammadot d) | Psi gammadot | steps per strain | wall s |")
-        print("|---|---|---|---|---|---|---|---|")
-        by_j = {}
-        for r in rows:
-            if r["status"] != "done":
-                continue
-            if all(str(r.get("axis." + k, "")) in (str(v), f"{v}") or
-                   (r.get("axis." + k) and float(r["axis." + k]) == float(v))
-                   for k, v in g["axes"].items()):
-                by_j.setdefault(float(r["J"]), r)
-        for row in sorted(g["rows"], key=lambda r: r["J"]):
-            r = by_j.get(row["J"], {})
-            print(f"| {row['J']:g} | {fmt(row['phi'], 4)} | {fmt(row['mu'])} | {fmt(row['D'])} | "
-                  f"{fmt(row['dv'])} | {fmt(row['psi'])} | "
-                  f"{fmt(float(r['steps_per_strain']), 4) if r.get('steps_per_strain') else '-'} | "
-                  f"{fmt(float(r['wall_seconds']), 4) if r.get('wall_seconds') else '-'} |")
+        print("Each cell: mean over seeds +- standard error of that mean (from the seeds' "
+              "scatter); [the runs' own error bars, rms / sqrt(n)].\n")
+        print("| J | seeds | phi | mu | D / (gammadot d^2) | dv / (gammadot d) | Psi gammadot |")
+        print("|---|---|---|---|---|---|---|")
+        for r in sorted(g["rows"], key=lambda r: r["J"]):
+            cells = []
+            for q, p in (("phi", 4), ("mu", 3), ("D", 3), ("dv", 3), ("psi", 3)):
+                c = pm(r.get(q), r.get(q + "_sem"), p)
+                if r.get(q + "_run_err") is not None:
+                    c += f" [{r[q + '_run_err']:.2g}]"
+                cells.append(c)
+            print(f"| {r['J']:g} | {r['runs']} | " + " | ".join(cells) + " |")
         f = g["fits"]
-        print("\n| law | sheardiff: a, b (+- standard errors) | seed Table 1: a, b |")
-        print("|---|---|---|")
+        print("\n| law | sheardiff: a, b (seed-bootstrap errors) | seed Table 1: a, b | a | b |")
+        print("|---|---|---|---|---|")
         for key, name in (("D_vs_J", "D/(gammadot d^2) = a J^b"),
                           ("dv_vs_J", "dv/(gammadot d) = a J^b"),
                           ("psi_vs_J", "Psi gammadot = a J^b"),
                           ("D_vs_phic_minus_phi", "D/(gammadot d^2) = a (phi_c - phi)^b"),
                           ("dv_vs_phic_minus_phi", "dv/(gammadot d) = a (phi_c - phi)^b"),
                           ("psi_vs_phic_minus_phi", "Psi gammadot = a (phi_c - phi)^b")):
-            s = seed[key]
-            print(f"| {name} | {law(f[key])} | {s['a']} +- {s['a_stderr']}, {s['b']} +- {s['b_stderr']} |")
+            s, ff = seed[key], f[key]
+            va = verdict(ff.get("a"), ff.get("a_stderr"), s["a"], s["a_stderr"]) if "a" in ff else "-"
+            vb = verdict(ff.get("b"), ff.get("b_stderr"), s["b"], s["b_stderr"]) if "b" in ff else "-"
+            print(f"| {name} | {law(ff)} | {s['a']} +- {s['a_stderr']}, {s['b']} +- "
+                  f"{s['b_stderr']} | {va} | {vb} |")
         p = f["phi_of_J"]
         if "phi_c" in p:
-            print(f"| phi = phi_c - a J^b | phi_c = {p['phi_c']:.4f} +- {p['phi_c_stderr']:.4f}, "
-                  f"a = {p['a']:.3g} +- {p['a_stderr']:.2g}, b = {p['b']:.3f} +- {p['b_stderr']:.3f} "
-                  f"| phi_c = 0.81, a = 0.64, b = 0.5 |")
+            warn = " (above the 2D close packing 0.9069: unphysical)" if p["phi_c"] > 0.9069 else ""
+            print(f"| phi = phi_c - a J^b | phi_c = {pm(p['phi_c'], p.get('phi_c_stderr'), 4)}"
+                  f"{warn}, a = {pm(p['a'], p.get('a_stderr'))}, b = {pm(p['b'], p.get('b_stderr'))} "
+                  f"| phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5 | phi_c: "
+                  f"{verdict(p['phi_c'], p.get('phi_c_stderr'), 0.81, 0.01)} | "
+                  f"{verdict(p['b'], p.get('b_stderr'), 0.5, 0.0)} |")
         m = f["mu_of_J"]
         if "mu_c" in m:
-            print(f"| mu = mu_c + a J^b | mu_c = {m['mu_c']:.3f} +- {m['mu_c_stderr']:.3f}, "
-                  f"a = {m['a']:.3g} +- {m['a_stderr']:.2g}, b = {m['b']:.3f} +- {m['b_stderr']:.3f} | - |")
+            print(f"| mu = mu_c + a J^b | mu_c = {pm(m['mu_c'], m.get('mu_c_stderr'))}, "
+                  f"a = {pm(m['a'], m.get('a_stderr'))}, b = {pm(m['b'], m.get('b_stderr'))} "
+                  f"| - | - | - |")
         print()
 
 
