@@ -100,6 +100,54 @@ def main():
                   f"a = {pm(m['a'], m.get('a_stderr'))}, b = {pm(m['b'], m.get('b_stderr'))} "
                   f"| - | - | - |")
         print()
+    causes(done)
+
+
+def mean_sem(v):
+    v = [x for x in v if x is not None and math.isfinite(x)]
+    if not v:
+        return None, None
+    m = sum(v) / len(v)
+    if len(v) < 2:
+        return m, None
+    return m, math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v))
+
+
+def causes(done):
+    """Per J (mean over seeds +- sem): the diagnostics of docs/results.md's candidate causes."""
+    def f(r, k):
+        try:
+            return float(r[k]) if r.get(k) not in (None, "") else None
+        except ValueError:
+            return None
+
+    by_j = {}
+    for r in done:
+        by_j.setdefault(f(r, "J"), []).append(r)
+    if not any(r.get("D_bulk") for r in done):
+        return
+    print("#### Diagnostics of the candidate causes (per J: mean over seeds +- sem)\n")
+    print("(b) bulk only / all discs; (c) shear rate of the bulk over V/H and mu_top - mu_bottom; "
+          "(e) D / (dv^2 Psi) for each definition of Psi.\n")
+    print("| J | D_bulk / D | dv_bulk / dv | Psi_bulk / Psi | bulk shear rate / (V/H) | "
+          "mu_top - mu_bottom | D/(dv^2 psi) | D/(dv^2 psi_e) | D/(dv^2 psi_full) | "
+          "D/(dv^2 psi_zero) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for j in sorted(k for k in by_j if k is not None):
+        rs = by_j[j]
+        cells = []
+        for num_k, den_k in (("D_bulk", "D"), ("dv_bulk", "dv"), ("psi_bulk", "psi")):
+            cells.append(mean_sem([f(r, num_k) / f(r, den_k) if f(r, num_k) and f(r, den_k)
+                                   else None for r in rs]))
+        cells.append(mean_sem([f(r, "bulk_shear_rate_ratio") for r in rs]))
+        cells.append(mean_sem([f(r, "mu_top") - f(r, "mu_bottom") if f(r, "mu_top") is not None
+                               and f(r, "mu_bottom") is not None else None for r in rs]))
+        for key in ("psi", "psi_e", "psi_full", "psi_zero"):
+            cells.append(mean_sem([f(r, "D") / (f(r, "dv") ** 2 * f(r, key))
+                                   if f(r, "D") and f(r, "dv") and f(r, key) else None
+                                   for r in rs]))
+        print(f"| {j:g} | " + " | ".join(pm(m, e) for m, e in cells) + " |")
+    print()
 
 
 if __name__ == "__main__":
