@@ -1,4 +1,4 @@
-// Run time against error (issue 5, model.md section 7): for the pressure-imposed plane shear
+// Run time against error (issue 5, docs/model.md section 7): for the pressure-imposed plane shear
 // at each (J, ktilde), one steady-ish starting state is made once (cached on disk), and from it
 // every integrator (euler, heun, implicit) runs a short strain window with every step-size
 // setting (adaptive with max displacement md, or a fixed dt). Each run is compared with the

@@ -41,7 +41,7 @@ class Simulation {
 // Pair interaction range over the sum of the radii: lubrication reaches gaps up to h_max.
 double interaction_range_factor(const Config& cfg);
 
-// Contact stability limit of explicit springs for these parameters (model.md section 7).
+// Contact stability limit of explicit springs for these parameters (docs/model.md section 7).
 double explicit_stability_dt(const Config& cfg);
 
 class Observer;

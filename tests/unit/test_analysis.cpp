@@ -1,4 +1,4 @@
-// Analysis library (model.md section 9, seed section 3 and Appendices B, D): MSD in both modes
+// Analysis library (docs/model.md section 9, seed section 3 and Appendices B, D): MSD in both modes
 // against brute force, ballistic and random-walk references; VACF / persistence time of an
 // Ornstein-Uhlenbeck velocity and D = dv^2 Psi on its integrated positions; power-law and
 // dilatancy fits with calibrated standard errors; bad input.

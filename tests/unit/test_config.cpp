@@ -89,7 +89,7 @@ TEST(Config, EmptyDocumentGivesTheDefaults) {
   const Config def;
   const Config cfg = parse_config("", "empty.toml");
   expect_same_config(cfg, def);
-  // The documented defaults (model.md section 10 and docs/config.md).
+  // The documented defaults (docs/model.md section 10 and docs/config.md).
   EXPECT_EQ(cfg.scene.type, "simple_shear");
   EXPECT_EQ(cfg.particles.n, 500);
   EXPECT_EQ(cfg.particles.mix, MixRule::Volume);
@@ -228,7 +228,7 @@ TEST(Config, OutOfRangeValuesNameKeyAndRange) {
   EXPECT_CONTAINS(nn, "-5");
   EXPECT_CONTAINS(nn, "[2, 1e+06]");
   EXPECT_CONTAINS(config_error("[particles]\nN = 1\n"), "particles.N");
-  // lubrication.h_max must stay below 1 (model.md section 10) and above 0.
+  // lubrication.h_max must stay below 1 (docs/model.md section 10) and above 0.
   EXPECT_CONTAINS(config_error("[lubrication]\nh_max = 1.5\n"), "lubrication.h_max");
   EXPECT_CONTAINS(config_error("[lubrication]\ndelta = 0.0\n"), "lubrication.delta");
   // Non-finite reals are rejected.

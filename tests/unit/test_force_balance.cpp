@@ -1,5 +1,5 @@
-// The per-step force/torque balance (model.md sections 3, 6 and 7): the assembled linear system
-// is solved to round-off, and the solved velocities balance drag and pair forces particle by
+// The per-step force/torque balance (docs/model.md sections 3, 6 and 7): the assembled linear
+// system is solved to round-off, and the solved velocities balance drag and pair forces particle by
 // particle.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Pair laws of model.md sections 4 and 5: the lubrication coefficients and their 6x6 block,
+// Pair laws of docs/model.md sections 4 and 5: the lubrication coefficients and their 6x6 block,
 // and the frictional spring contact.
 #include <gtest/gtest.h>
 
@@ -23,7 +23,7 @@ struct Radii {
 };
 const Radii kSizePairs[] = {{0.5, 0.5}, {0.5, 0.7}, {0.7, 0.5}};
 
-// model.md section 4, written out independently of the library (eta = 1).
+// docs/model.md section 4, written out independently of the library (eta = 1).
 PairResistance reference_coefficients(double ai, double aj, double h, double delta) {
   const double he = std::max(h, 0.0) + delta;
   const double ln = 1.0 / he;
@@ -68,7 +68,7 @@ TEST(Lubrication, CoefficientsMatchClosedFormsForBothSizePairs) {
 }
 
 TEST(Lubrication, EqualSpheresReproduceTheQuotedNumbers) {
-  // model.md: XA = 2.356/(h+delta), YA = 1.571 Lt, beta = 0.785 Lt, gam_ii = 0.628 Lt,
+  // docs/model.md: XA = 2.356/(h+delta), YA = 1.571 Lt, beta = 0.785 Lt, gam_ii = 0.628 Lt,
   // gam_ij = 0.157 Lt, printed to 4 significant digits, so they hold to half a unit of the last
   // printed digit (5e-4). The exact values are 3pi/4, pi/2, pi/4, pi/5 and pi/20.
   const double delta = 0.01;
@@ -194,7 +194,7 @@ TEST(PairResistanceMatrix, SymmetricAndPositiveSemiDefinite) {
 }
 
 TEST(PairResistanceMatrix, ForceAndTorqueFollowTheModelFormulas) {
-  // -R U must be the force/torque of model.md section 4 written component by component.
+  // -R U must be the force/torque of docs/model.md section 4 written component by component.
   const Lubrication lub{0.01, 0.5};
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> uni(-1.0, 1.0), angle(0.0, 2.0 * kPi);
@@ -352,7 +352,7 @@ TEST(FrictionalContact, NormalSpringForce) {
 }
 
 TEST(FrictionalContact, TangentialSpringForceAndTorques) {
-  // F_i = +kt xi t, F_j = -F_i, T_i = a_i kt xi, T_j = a_j kt xi (model.md section 5).
+  // F_i = +kt xi t, F_j = -F_i, T_i = a_i kt xi, T_j = a_j kt xi (docs/model.md section 5).
   const FrictionalContact c{1e4, 5e3, 0.5};
   const PairGeometry g = touching(0.5, 0.7, 0.0, 0.7);  // exactly touching: no normal force
   const double xi = -3e-4;

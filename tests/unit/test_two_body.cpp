@@ -18,7 +18,7 @@
 namespace sheardiff {
 namespace {
 
-constexpr double kDelta = 0.01;  // lubrication regularisation (Config default, model.md s. 4)
+constexpr double kDelta = 0.01;  // lubrication regularisation (Config default, docs/model.md s. 4)
 
 Config two_body_config(IntegratorType type, double dt, double ktilde) {
   Config cfg;
@@ -72,7 +72,7 @@ PairGeometry geometry(const Simulation& sim) {
 //   F = zeta_i v_i + XA w = zeta_j v_j + XA w,      zeta_k = 3 pi d_k,
 // so w = F m / (1 + XA m) with m = 1/zeta_i + 1/zeta_j (equal discs: w = 2F/(zeta + 2 XA), i.e.
 // v = F/(zeta + 2 XA) as in the brief), and since h = 2r/s - 2,  dh/dt = -(2/s) w.
-// XA = 6 pi * 2 a_i^2 a_j^2 / s^3 / (h + delta)  (model.md section 4, written out here
+// XA = 6 pi * 2 a_i^2 a_j^2 / s^3 / (h + delta)  (docs/model.md section 4, written out here
 // independently of Lubrication::coefficients).
 struct SqueezeOde {
   double ai, aj, force;
@@ -231,7 +231,7 @@ TEST(TwoBodyContact, SteadyOverlapIsForceOverStiffness) {
 //
 // A single tangential force on one disc mostly rolls or translates the pair (rigid motions do
 // not stretch the spring), so the tangential load is applied as a pure "shearing" of the contact:
-// the generalised load that the spring alone can balance. With the spring law of model.md
+// the generalised load that the spring alone can balance. With the spring law of docs/model.md
 // (F_i = kt xi t, T_i = a_i kt xi, F_j = -F_i, T_j = a_j kt xi) the external load
 //   on i: fn n - ft t, torque -ft a_i;    on j: -fn n + ft t, torque -ft a_j
 // is in static equilibrium (U = 0) exactly when kn overlap = fn and kt xi = ft. Coulomb allows
@@ -268,7 +268,7 @@ double coulomb_ratio(const Simulation& sim, const ContactParams& c) {
 // a_j). For equal discs the resistance A = drag + R_pair(h = 0) maps the antisymmetric-tangential
 // and rotational subspace (which holds w) onto itself and never mixes it with m (A w has no n
 // component), so the implicit normal stiffness dt kn m m^T does not enter and the slip rate
-// v_s = -w.U is  v_s = (ft - mu kn overlap) w^T A^-1 w.  A is written out from model.md s. 3-5
+// v_s = -w.U is  v_s = (ft - mu kn overlap) w^T A^-1 w.  A is written out from docs/model.md s. 3-5
 // (dashpots = lubrication at h = 0: Ln = 1/delta, Lt = ln(1/delta)).
 double slip_mobility(const PairGeometry& g) {
   const double ai = g.ai, aj = g.aj, s = ai + aj, c = 6.0 * kPi;
@@ -383,7 +383,8 @@ TEST(TwoBodyContact, SlidingSpeedMatchesAnalyticHeun) {
 }
 
 // Same for the implicit integrator (the start-of-step geometry is the one read, so it should be
-// even closer). A sliding contact must get no tangential stiffness in the matrix (model.md s. 7).
+// even closer). A sliding contact must get no tangential stiffness in the matrix
+// (docs/model.md s. 7).
 TEST(TwoBodyContact, SlidingSpeedMatchesAnalyticImplicit) {
   for (double fn_rate : {0.0, 0.02, -0.02}) {
     SCOPED_TRACE("fn_rate=" + std::to_string(fn_rate));
@@ -419,8 +420,8 @@ TEST(TwoBodyContact, StickingSpringCarriesTangentialLoad) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// 4. Tangential spring reset (model.md section 5: a contact starts with xi = 0 and ends as soon
-// as h > 0). Build up xi with a sticking load, pull the discs apart, then push them back.
+// 4. Tangential spring reset (docs/model.md section 5: a contact starts with xi = 0 and ends as
+// soon as h > 0). Build up xi with a sticking load, pull the discs apart, then push them back.
 TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
   for (IntegratorType type : {IntegratorType::Implicit, IntegratorType::Heun}) {
     SCOPED_TRACE(to_string(type));
@@ -503,8 +504,8 @@ TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
 // A contact left sliding at the Coulomb cap whose tangential load is then removed must come to
 // rest: the stretched spring drives the slip back, the contact sticks (|xi| < cap) and relaxes to
 // xi = 0, U = 0. The implicit integrator carries a sliding contact's force explicitly (no
-// tangential stiffness, model.md s. 7). At a step where that explicit cap force reverses the slip
-// by more than the cap within one step (kn = 1e4, dt = 0.02: cap xi = overlap = 1e-4, slip per
+// tangential stiffness, docs/model.md s. 7). At a step where that explicit cap force reverses the
+// slip by more than the cap within one step (kn = 1e4, dt = 0.02: cap xi = overlap = 1e-4, slip per
 // step ~ 0.5 x slip mobility (~0.1) x dt ~ 1e-3), treating the contact as still sliding flips xi
 // from +cap to -cap every step: a chatter that never sticks, whose friction force averages to
 // zero and spins the discs back and forth. A contact whose slip opposes its spring is not

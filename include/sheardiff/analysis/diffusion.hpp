@@ -18,7 +18,7 @@ struct DiffusionSettings {
   std::uint64_t seed = 1;
 };
 
-// Self-diffusion in the gradient direction (seed paper section 3, model.md section 9) from
+// Self-diffusion in the gradient direction (seed paper section 3, docs/model.md section 9) from
 // frames uniformly spaced by frame_strain: y (frames x particles, unwrapped, in d) and vy
 // (frames x particles, v_y / gammadot, in d per unit strain). Times are strains, so D comes out
 // in gammadot d^2, dv in gammadot d and Psi in 1/gammadot.

@@ -6,7 +6,8 @@
 
 namespace sheardiff {
 
-// Trajectory analysis of frames sampled uniformly in time (model.md section 9, seed section 3).
+// Trajectory analysis of frames sampled uniformly in time (docs/model.md section 9, seed
+// section 3).
 // Inputs are frames x particles (row = frame, column = particle, so a particle's history is
 // contiguous). dt is the frame spacing in whatever unit the caller uses (strain or time); the
 // functions never assume one. Bad input throws std::invalid_argument.

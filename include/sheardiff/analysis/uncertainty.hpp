@@ -7,9 +7,9 @@
 
 namespace sheardiff {
 
-// Statistical errors of one run's measured quantities from the run's own data (docs/numerics.md,
-// "Error bars"). All three estimators cut the measured window into consecutive time blocks
-// longer than the correlation time of what they average, so that blocks are close to
+// Statistical errors of one run's measured quantities from the run's own data (docs/model.md
+// section 9, "Error bars"). All three estimators cut the measured window into consecutive time
+// blocks longer than the correlation time of what they average, so that blocks are close to
 // independent while particles inside a block may be correlated in any way (collective motion
 // is what makes independent runs scatter more than a particle count suggests).
 

@@ -12,7 +12,7 @@
 
 namespace sheardiff {
 
-// Limits on one step (model.md section 7). fixed_dt > 0 switches the adaptive choice off.
+// Limits on one step (docs/model.md section 7). fixed_dt > 0 switches the adaptive choice off.
 struct StepLimits {
   double fixed_dt = 0.0;
   double max_displacement = 1e-3;  // non-affine, d

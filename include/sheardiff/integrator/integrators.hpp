@@ -7,7 +7,7 @@
 
 namespace sheardiff {
 
-// A time-stepping policy over Dynamics (model.md section 7).
+// A time-stepping policy over Dynamics (docs/model.md section 7).
 class Integrator {
  public:
   virtual ~Integrator() = default;

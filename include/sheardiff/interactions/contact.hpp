@@ -10,7 +10,7 @@ struct ContactHistory {
   bool sliding = false; // the last step capped xi at the Coulomb limit
 };
 
-// Linear spring contact with Coulomb friction (model.md section 5). Forces act in the
+// Linear spring contact with Coulomb friction (docs/model.md section 5). Forces act in the
 // 6-vector space (u_x, u_y, omega)_i, (u_x, u_y, omega)_j of the pair.
 struct FrictionalContact {
   double kn = 1e4;

@@ -10,7 +10,7 @@ struct PairResistance {
   double gam_ii = 0, gam_jj = 0, gam_ij = 0;  // pump / rotation
 
   // The 6x6 block R_pair in the order (u_x, u_y, omega)_i, (u_x, u_y, omega)_j
-  // (model.md section 4); the pair's force and torque are -R_pair U.
+  // (docs/model.md section 4); the pair's force and torque are -R_pair U.
   Mat6 matrix(const Vec2& n, const Vec2& t) const;
 };
 

@@ -41,7 +41,7 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
                        const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
                        double from, double to, double block);
 
-// Observables of the pressure-imposed plane shear cell (model.md section 9): gap H, bulk phi,
+// Observables of the pressure-imposed plane shear cell (docs/model.md section 9): gap H, bulk phi,
 // mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
 // drift of H and mu, and phi(y), u_x(y), T(y) profiles averaged over the steady window.
 class PressureCellObserver final : public Observer {

@@ -4,7 +4,7 @@
 
 namespace sheardiff {
 
-// Pair stress and contact statistics of one configuration (model.md section 9):
+// Pair stress and contact statistics of one configuration (docs/model.md section 9):
 // sigma = -(1 / (area lz)) sum over pairs of sym(l n (x) F_j), l = r in contact, s otherwise,
 // F_j the pair force on j. Tension positive: pressure = -(sigma_xx + sigma_yy) / 2.
 struct StressSample {

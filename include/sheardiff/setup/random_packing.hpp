@@ -22,7 +22,7 @@ struct Packing {
 
 // Random non-overlapping discs in a periodic lx x ly cell at area fraction phi. Random
 // sequential addition up to phi = 0.5; denser targets are reached by shrinking the cell in
-// small steps and relaxing the overlaps with a soft repulsion (model.md section 2).
+// small steps and relaxing the overlaps with a soft repulsion (docs/model.md section 2).
 // Reproducible for a given seed.
 Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,
                        std::uint64_t seed);

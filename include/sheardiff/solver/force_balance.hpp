@@ -13,7 +13,7 @@
 namespace sheardiff {
 
 // The rigid top wall: x velocity imposed, y velocity solved so that the suspension pushes on it
-// with exactly `load` = P Lx lz (model.md section 6).
+// with exactly `load` = P Lx lz (docs/model.md section 6).
 struct WallDrive {
   double vx = 0.0;
   double load = 0.0;

@@ -13,8 +13,9 @@
 
 namespace sheardiff {
 
-// The per-step force/torque balance A U + b V = g of the mobile particles (model.md section 6),
-// with A = drag + sum of pair blocks (+ dt K for implicit springs) symmetric positive definite.
+// The per-step force/torque balance A U + b V = g of the mobile particles (docs/model.md
+// section 6), with A = drag + sum of pair blocks (+ dt K for implicit springs) symmetric
+// positive definite.
 // Unknowns: `dof` per mobile particle (3 = u_x, u_y, omega; 2 = no rotation), plus the
 // optional y velocity V of one floating wall, eliminated by two back-solves on one factor.
 // The sparsity pattern (and the symbolic factorisation) are rebuilt only with the neighbour
