@@ -80,7 +80,7 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
       throw ConfigError(fmt::format(
           "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
           "eta/P of explicit springs (smallest pair, normal and slip modes, "
-          "model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < "
+          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < "
           "{:.3g}, integrator.dt = 0 (adaptive), or "
           "integrator.type = \"implicit\"",
           origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
