@@ -243,6 +243,7 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
     reap();
     if (stop_signal && running.empty()) break;
   }
+  if (!stop_signal) progress();  // the last line: every point done, when
   sigprocmask(SIG_SETMASK, &old_mask, nullptr);
   if (stop_signal)
     throw RunInterrupted(stop_signal,
