@@ -15,6 +15,8 @@
 #include <sstream>
 #include <variant>
 
+#include "sheardiff/io/text.hpp"
+
 namespace sheardiff {
 
 const char* to_string(IntegratorType t) {
@@ -369,12 +371,9 @@ std::string describe(const toml::node& n) {
   std::ostringstream os;
   if (n.is_string()) os << '"' << *n.value<std::string>() << '"';
   // Shortest form that reads back exactly: -0.1, not -0.10000000000000001.
-  else if (n.is_floating_point()) {
-    std::string t = fmt::format("{}", *n.value<double>());
-    // Kept recognisable as a TOML float: 2.0, not 2.
-    if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
-    os << t;
-  } else if (n.is_table())
+  else if (n.is_floating_point())
+    os << toml_float(*n.value<double>());
+  else if (n.is_table())
     os << "a table";
   else if (n.is_array())
     os << "an array";
@@ -556,13 +555,13 @@ Config load_config(const std::filesystem::path& file, const std::vector<std::str
                                       : "it is not a regular file"));
   std::ifstream in(file);
   if (!in)
-    throw ConfigError(fmt::format("{}: cannot open the config file: {}", file.string(),
-                                  std::strerror(errno)));
+    throw ConfigError(
+        fmt::format("{}: cannot open the config file: {}", file.string(), std::strerror(errno)));
   std::stringstream ss;
   ss << in.rdbuf();
   if (in.bad())
-    throw ConfigError(fmt::format("{}: cannot read the config file: {}", file.string(),
-                                  std::strerror(errno)));
+    throw ConfigError(
+        fmt::format("{}: cannot read the config file: {}", file.string(), std::strerror(errno)));
   const std::string text = ss.str();
   Config cfg = parse_config(text, file.string(), overrides);
   // An empty or truncated file would otherwise run the default scene: the scene is the one
@@ -577,46 +576,92 @@ Config load_config(const std::filesystem::path& file, const std::vector<std::str
   return cfg;
 }
 
+namespace {
+
+// A value as TOML: floats in their shortest round-trip form (0.7, not 0.69999999999999996;
+// toml++'s own formatter writes 17 digits), strings quoted and escaped.
+std::string toml_value(const Value& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::string>)
+          return toml_string(x);
+        else if constexpr (std::is_same_v<T, bool>)
+          return x ? "true" : "false";
+        else if constexpr (std::is_same_v<T, double>)
+          return toml_float(x);
+        else
+          return fmt::format("{}", x);
+      },
+      v);
+}
+
+// A default for the reference: 0.7, 1e-06, 500, "uniform", true.
+std::string default_text(const Value& v) {
+  if (const double* x = std::get_if<double>(&v)) return fmt::format("{}", *x);
+  return toml_value(v);
+}
+
+const char* type_name(Kind kind) {
+  return kind == Kind::Real      ? "real"
+         : kind == Kind::Integer ? "integer"
+         : kind == Kind::Boolean ? "bool"
+                                 : "string";
+}
+
+std::pair<std::string, std::string> split_key(const std::string& key) {
+  const auto dot = key.find('.');
+  return {key.substr(0, dot), key.substr(dot + 1)};
+}
+
+}  // namespace
+
 std::string to_toml(const Config& cfg) {
-  std::map<std::string, toml::table> sections;
+  std::map<std::string, std::string> sections;
   std::vector<std::string> order;
   for (const auto& k : schema()) {
-    const auto dot = k.key.find('.');
-    const std::string sec = k.key.substr(0, dot), name = k.key.substr(dot + 1);
+    const auto [sec, name] = split_key(k.key);
     if (!sections.count(sec)) order.push_back(sec);
-    auto& t = sections[sec];
-    std::visit([&](const auto& x) { t.insert(name, x); }, k.get(cfg));
+    sections[sec] += name + " = " + toml_value(k.get(cfg)) + "\n";
   }
-  std::ostringstream os;
-  for (const auto& sec : order) os << '[' << sec << "]\n" << sections[sec] << "\n\n";
-  return os.str();
+  std::string out;
+  for (const auto& sec : order) out += '[' + sec + "]\n" + sections[sec] + "\n";
+  return out;
 }
 
 std::string config_reference_markdown() {
   std::ostringstream os;
   os << "| key | type | default | allowed | unit | meaning |\n|---|---|---|---|---|---|\n";
   const Config def;
-  for (const auto& k : schema()) {
-    std::string dflt;
-    std::visit(
-        [&](const auto& x) {
-          using T = std::decay_t<decltype(x)>;
-          if constexpr (std::is_same_v<T, std::string>)
-            dflt = "\"" + x + "\"";
-          else if constexpr (std::is_same_v<T, bool>)
-            dflt = x ? "true" : "false";
-          else
-            dflt = fmt::format("{:g}", static_cast<double>(x));
-        },
-        k.get(def));
-    const char* type = k.kind == Kind::Real      ? "real"
-                       : k.kind == Kind::Integer ? "integer"
-                       : k.kind == Kind::Boolean ? "bool"
-                                                 : "string";
-    os << "| `" << k.key << "` | " << type << " | " << dflt << " | " << range_text(k) << " | "
-       << (k.unit.empty() ? "-" : k.unit) << " | " << k.doc << " |\n";
-  }
+  for (const auto& k : schema())
+    os << "| `" << k.key << "` | " << type_name(k.kind) << " | " << default_text(k.get(def))
+       << " | " << range_text(k) << " | " << (k.unit.empty() ? "-" : k.unit) << " | " << k.doc
+       << " |\n";
   return os.str();
+}
+
+std::string config_reference_text(std::size_t width) {
+  std::string out = wrap_text(
+      "sheardiff configuration: every key with its meaning, type, allowed values, unit and "
+      "default, as a TOML file of the defaults (a config file must set scene.type; every other "
+      "key is optional). Units: docs/units.md. The same as a Markdown table: sheardiff "
+      "config-doc --markdown (docs/config.md).",
+      width, "# ");
+  const Config def;
+  std::string section;
+  for (const auto& k : schema()) {
+    const auto [sec, name] = split_key(k.key);
+    if (sec != section) {
+      out += "\n[" + sec + "]\n";
+      section = sec;
+    }
+    out += wrap_text(k.doc, width, "# ");
+    out += wrap_text(
+        fmt::format("allowed: {}{}", range_text(k), k.unit.empty() ? "" : "; unit: " + k.unit),
+        width, "#   ");
+    out += name + " = " + toml_value(k.get(def)) + "\n";
+  }
+  return out;
 }
 
 }  // namespace sheardiff

@@ -20,12 +20,14 @@
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
+#include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/observe/stress.hpp"
 #include "sheardiff/setup/random_packing.hpp"
+#include "sheardiff/version.hpp"
 
 namespace sheardiff {
 
@@ -216,6 +218,16 @@ bool same_config(const std::filesystem::path& file, const std::string& resolved)
     return false;
   }
 }
+// The same for the resolved text a checkpoint holds: an older sheardiff wrote it with other
+// keys or other float digits (0.69999999999999996 for 0.7).
+bool same_config_text(const std::string& text, const std::string& resolved) {
+  if (text == resolved) return true;
+  try {
+    return to_toml(parse_config(text, "checkpoint.bin")) == resolved;
+  } catch (const ConfigError&) {
+    return false;
+  }
+}
 
 std::string refusal(const RunDirectory& dir) {
   const std::string d = dir.path().string();
@@ -265,11 +277,16 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
 }
 
 // A function-try-block: every failure of the run passes the handlers at the end.
-nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode,
-                                bool progress) try {
+nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode, bool progress,
+                                double progress_seconds) try {
   // From here SIGINT/SIGTERM only set a flag: a signal during the set-up (minutes for a large
   // packing) stops the run at step 0 with a checkpoint instead of leaving a bare directory.
   StopSignals signals;
+  // When the run started (a resumed run: its first start, kept in the checkpoint), as Unix
+  // seconds; -1: unknown (a checkpoint of a sheardiff before the start was kept).
+  std::int64_t started = std::chrono::duration_cast<std::chrono::seconds>(
+                             std::chrono::system_clock::now().time_since_epoch())
+                             .count();
   Config cfg = given;
   resolve_defaults(cfg);
   const std::string resolved = to_toml(cfg);
@@ -325,11 +342,12 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   double elapsed_before = 0.0;
   long frames = 0;
   // The whole evolving state of the run, in one fixed order for saving and loading.
-  // with_counters: version 3 checkpoints also hold the solver's work counters.
+  // with_counters: version 3 checkpoints also hold the solver's work counters, and after them
+  // the run's start time (absent from those of a sheardiff before it: then unknown).
   const auto serialize = [&](Archive& a, bool with_counters) {
     std::string config = resolved;
     a.io(config);
-    if (config != resolved)
+    if (!same_config_text(config, resolved))
       throw ConfigError(fmt::format(
           "--resume {}: the configuration differs from the one the checkpoint was written with "
           "(see {}/config.toml)",
@@ -339,7 +357,13 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
     for (auto& o : observers) o->serialize(a);
     health.serialize(a);
     a.io(next_frame), a.io(next_checkpoint), a.io(elapsed_before), a.io(frames);
-    if (with_counters) d.force_balance().system().serialize_counters(a);
+    if (with_counters) {
+      d.force_balance().system().serialize_counters(a);
+      if (!a.loading() || !a.at_end())
+        a.io(started);
+      else
+        started = -1;
+    }
   };
   if (from_checkpoint) {
     Archive a = Archive::reader(std::move(checkpoint.bytes));
@@ -409,12 +433,15 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
     write_file_atomically(checkpoint_file, bytes.data(), bytes.size());
   };
 
-  const bool tty = progress && isatty(fileno(stderr));
+  // Progress: a live line redrawn on a terminal (not logged), and a timestamped line every
+  // progress_seconds on stderr off a terminal, or in run.log alone (a terminal, --quiet).
+  const bool tty = progress && dir.terminal();
   const auto t0 = std::chrono::steady_clock::now();
   const auto seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
-  auto last_print = t0, last_flush = t0;
+  auto last_print = t0, last_line = t0, last_flush = t0;
+  bool shown = false;  // a live line is on the terminal: end it before anything else
   std::vector<double> values;
   const auto finished = [&] {
     for (const auto& o : observers)
@@ -427,13 +454,13 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   const auto stop = [&](const HealthReport& r) {
     if (r.state_finite) save_checkpoint(seconds());
     write_diagnostic(dir.file("diagnostic.txt"), d, sim.integrator().velocities(), r);
-    if (tty) std::fprintf(stderr, "\n");
+    if (shown) std::fprintf(stderr, "\n");
     throw RunUnhealthy(r);
   };
   while (!finished()) {
     if (const int sig = g_stop_signal.load()) {
       save_checkpoint(seconds());
-      if (tty) std::fprintf(stderr, "\n");
+      if (shown) std::fprintf(stderr, "\n");
       throw RunInterrupted(
           sig,
           fmt::format(
@@ -475,20 +502,31 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
       }
     }
     const auto now = std::chrono::steady_clock::now();
-    // A terminal gets a live line; a batch log gets one line a minute. The trajectory is
-    // flushed every half minute so that a killed run leaves readable frames behind.
-    const auto since = now - last_print;
-    if ((tty && since > std::chrono::milliseconds(500)) ||
-        (!tty && progress && since > std::chrono::seconds(60))) {
-      last_print = now;
+    // The trajectory is flushed every half minute so that a killed run leaves readable frames.
+    const bool live = tty && now - last_print > std::chrono::milliseconds(500);
+    const bool line = std::chrono::duration<double>(now - last_line).count() > progress_seconds;
+    if (live || line) {
       const double el = std::chrono::duration<double>(now - t0).count();
       // A pressure cell that has found its steady state stops at steady + measure_strain.
       double end = cfg.run.strain;
       for (const auto& o : observers) end = std::min(end, o->planned_end_strain());
       const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
-      std::fprintf(stderr, "%sstrain %.4g / %.4g  steps %ld  %.0f steps/s  ETA %.0f s%s",
-                   tty ? "\r" : "", d.strain(), end, d.steps(), d.steps() / el, eta,
-                   tty ? "   " : "\n");
+      const std::string text =
+          fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
+                      d.steps(), static_cast<double>(d.steps()) / el, duration_text(eta));
+      if (live) {
+        std::fprintf(stderr, "\r%s   ", text.c_str());
+        last_print = now;
+        shown = true;
+      }
+      if (line) {
+        const std::string stamped = fmt::format("{}  {}\n", iso8601_utc_now(), text);
+        if (progress && !tty)
+          std::fputs(stamped.c_str(), stderr);
+        else
+          dir.log_only(stamped);
+        last_line = now;
+      }
     }
     if (writer && now - last_flush > std::chrono::seconds(30)) {
       writer->flush();
@@ -501,13 +539,23 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
     if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
       stop(*r);
   }
-  if (tty) std::fprintf(stderr, "\n");
+  if (shown) std::fprintf(stderr, "\n");
   const double wall = elapsed_before + seconds();
 
   // The end of the run. Every write below replaces what an earlier attempt may have written
   // (tables, analysis.h5, summary.json), so a death anywhere in it resumes from the last
   // checkpoint and completes; summary.json, written last, marks the run finished.
   nlohmann::json js;
+  js["version"] = version();
+  js["git_hash"] = git_hash();
+  js["host"] = host_name();
+  js["seed"] = cfg.run.seed;
+  if (started >= 0)
+    js["started"] =
+        iso8601_utc(std::chrono::system_clock::time_point(std::chrono::seconds(started)));
+  else
+    js["started"] = nullptr;
+  js["finished"] = iso8601_utc_now();
   js["scene"] = cfg.scene.type;
   js["N"] = cfg.particles.n;
   js["J"] = cfg.flow.j;
@@ -552,7 +600,7 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
     throw IoError(fmt::format("cannot write {}: {}", analysis.string(),
                               reason.empty() ? "the file was left incomplete" : reason));
   }
-  write_file_atomically(dir.file("summary.json"), js.dump(2) + "\n");
+  write_file_atomically(dir.file("summary.json"), json_text(js) + "\n");
   // Finished: the summary marks the run complete and the checkpoint has served its purpose.
   std::filesystem::remove(checkpoint_file);
   return js;

@@ -123,10 +123,16 @@ void resolve_defaults(Config& cfg);
 // integrator.max_overlap_change, or when it is 0, min(max_displacement, 10 d / ktilde), i.e.
 // ten typical overlaps P d / kn (docs/performance.md, "Stiff contacts").
 double overlap_change_limit(const Config& cfg);
-// The resolved configuration as TOML (every key, defaults filled in).
+// The resolved configuration as TOML (every key, defaults filled in; floats in the shortest
+// text that parses back to the same double).
 std::string to_toml(const Config& cfg);
-// Markdown table of every key: name, type, default, allowed range, unit, meaning.
+// Markdown table of every key: name, type, default, allowed range, unit, meaning
+// (`sheardiff config-doc --markdown`, docs/config.md).
 std::string config_reference_markdown();
+// The same for a terminal (`sheardiff config-doc`): a TOML file of the defaults, each key under
+// its meaning, type, range and unit as comments, lines at most `width` columns (a longer line
+// only where a single word is longer).
+std::string config_reference_text(std::size_t width = 100);
 
 const char* to_string(IntegratorType t);
 const char* to_string(MixRule m);

@@ -85,8 +85,11 @@ enum class RunMode { start, overwrite, resume };
 // stopped. Nothing in DIR is changed before the configuration, the initial state and the
 // checkpoint have been checked. Throws ConfigError (exit 2: refused, nothing changed), IoError
 // (exit 1: DIR left resumable), RunUnhealthy (4), RunInterrupted (128 + signal). Returns the
-// summary.
-nlohmann::json run_to_directory(const Config& cfg, RunDirectory& dir, RunMode mode, bool progress);
+// summary (with the version, git hash, host, seed, start and end time of the run).
+// progress: progress on stderr, a live line on a terminal, else a line with an ISO 8601 UTC
+// timestamp every progress_seconds; run.log gets those timestamped lines in any case.
+nlohmann::json run_to_directory(const Config& cfg, RunDirectory& dir, RunMode mode, bool progress,
+                                double progress_seconds = 60.0);
 // The same in a RunDirectory of its own: resume ? RunMode::resume : RunMode::start.
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume = false);

@@ -20,6 +20,7 @@
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
+#include "sheardiff/version.hpp"
 
 namespace {
 // Exit codes (README, docs/stability.md): 0 done, 1 I/O and other errors, 2 refused before
@@ -31,7 +32,7 @@ constexpr int kExitIo = 1;
 constexpr int kExitConfig = 2;
 constexpr int kExitNumerical = 3;
 int run_sweep(const std::string& file, const std::filesystem::path& out, int jobs,
-              std::string backend, long point, bool collect_only) {
+              std::string backend, long point, bool collect_only, bool quiet) {
   namespace sd = sheardiff;
   const auto spec = sd::load_sweep(file);
   if (backend.empty()) backend = spec.backend;
@@ -66,14 +67,16 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
           array.empty() ? "none" : array, collect, out.string());
       return 0;
     }
-    failed = sd::run_local(spec, out, jobs > 0 ? jobs : spec.jobs, exe);
+    failed = sd::run_local(spec, out, jobs > 0 ? jobs : spec.jobs, exe, !quiet);
     if (failed > 0)
       fmt::print(stderr, "sweep: {} point(s) failed; collecting the others\n", failed);
   }
   const auto fits = sd::collect_sweep(spec, out);
   fmt::print("{}: {}/{} points finished; {}/sweep.csv, {}/fits.json\n", out.string(),
              fits["finished"].get<long>(), fits["points"].get<long>(), out.string(), out.string());
-  for (const auto& g : fits["groups"]) {
+  // --quiet: the one line above; the fits are in fits.json.
+  const nlohmann::json none = nlohmann::json::array();
+  for (const auto& g : quiet ? none : fits["groups"]) {
     const auto& f = g["fits"];
     fmt::print("  {}:", g["axes"].dump());
     for (const char* k : {"D_vs_J", "dv_vs_J", "psi_vs_J"})
@@ -132,6 +135,8 @@ int main(int argc, char** argv) {
   sheardiff::quiet_hdf5_for_process();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", sheardiff::version_line(),
+                       "Print the version and git commit, and exit");
 
   std::string config_path, out_dir = "out";
   std::vector<std::string> overrides;
@@ -159,12 +164,28 @@ int main(int argc, char** argv) {
       "Run in --out DIR even if it holds a run: every file of that run is deleted first");
   resume_opt->excludes(out_opt);
   resume_opt->excludes(overwrite_opt);
+  bool quiet = false;
+  run->add_flag("-q,--quiet", quiet,
+                "No progress line; errors, warnings and the result's first line are still "
+                "printed, and DIR/run.log still gets everything");
+  double progress_seconds = 60.0;
+  run->add_option("--progress-every", progress_seconds,
+                  "Seconds between the timestamped progress lines written off a terminal and "
+                  "to DIR/run.log")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
 
   auto* check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
   check->add_option("--set", overrides, "Override one key, section.key=value (repeatable)");
 
-  auto* doc = app.add_subcommand("config-doc", "Print the reference table of every config key");
+  auto* doc = app.add_subcommand(
+      "config-doc",
+      "Print every config key with its meaning, type, range, unit and default, as a commented "
+      "TOML file of the defaults (lines of at most 100 columns)");
+  bool markdown = false;
+  doc->add_flag("--markdown", markdown,
+                "Print the Markdown table instead (the one docs/config.md is made from)");
 
   std::string run_dir;
   auto* analyse = app.add_subcommand(
@@ -193,6 +214,8 @@ int main(int argc, char** argv) {
   sweep->add_flag("--collect", collect_only,
                   "Only collect finished points into sweep.csv and "
                   "fits.json (what the Slurm collect job does)");
+  sweep->add_flag("-q,--quiet", quiet,
+                  "No progress lines; failures and the result's first line are still printed");
 
   try {
     app.parse(argc, argv);
@@ -206,7 +229,8 @@ int main(int argc, char** argv) {
   std::optional<sheardiff::RunDirectory> dir;
   try {
     if (doc->parsed()) {
-      std::cout << sheardiff::config_reference_markdown();
+      std::cout << (markdown ? sheardiff::config_reference_markdown()
+                             : sheardiff::config_reference_text());
       return 0;
     }
     if (analyse->parsed()) {
@@ -252,7 +276,8 @@ int main(int argc, char** argv) {
       print_warnings(js);
       return 0;
     }
-    if (sweep->parsed()) return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only);
+    if (sweep->parsed())
+      return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only, quiet);
     if (check->parsed() && sheardiff::is_sweep_file(config_path)) {
       // A sweep file: every point's config is built and validated (load_sweep), then listed.
       if (!overrides.empty())
@@ -285,7 +310,7 @@ int main(int argc, char** argv) {
           "and run that copy",
           config_path, out_dir));
     dir.emplace(out_dir, mode != RunMode::resume);
-    const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, true);
+    const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, !quiet, progress_seconds);
     const auto flag = [&](const char* key) {
       const auto it = summary.find(key);
       return it != summary.end() && it->is_boolean() && it->get<bool>();
@@ -297,35 +322,43 @@ int main(int argc, char** argv) {
     fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
                out_dir, num(summary, "strain"), count("steps"), num(summary, "wall_seconds"),
                num(summary, "ms_per_step"), num(summary, "max_overlap"));
+    // The lines after the first: on the terminal unless --quiet, in run.log always.
+    std::string details;
     if (summary.contains("steady")) {
       if (!flag("steady")) {
-        fmt::print("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
-                   num(summary, "phi"));
+        details +=
+            fmt::format("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
+                        num(summary, "phi"));
       } else {
-        fmt::print(
+        details += fmt::format(
             "  steady from strain {:.3g}: phi = {:.4f} +- {:.2g}, mu = {:.4f} +- {:.2g}, H = "
             "{:.3f} d (+- statistical errors, time blocks)\n",
             num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_err"),
             num(summary, "mu"), num(summary, "mu_err"), num(summary, "H"));
-        fmt::print(
+        details += fmt::format(
             "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
             "held steps)\n",
             num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
             count("steps") - count("wall_free_fall_steps"));
       }
     } else if (std::isnan(num(summary, "shear_stress"))) {
-      fmt::print("  no averages: the run ended before run.transient_strain\n");
+      details += fmt::format("  no averages: the run ended before run.transient_strain\n");
     } else {
-      fmt::print("  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
-                 num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
+      details += fmt::format(
+          "  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
+          num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
     }
     if (summary.contains("D"))
-      fmt::print(
+      details += fmt::format(
           "  diffusion: D = {:.4g} +- {:.2g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
           "+- {:.2g} gammadot d, Psi = {:.4g} +- {:.2g} / gammadot\n",
           num(summary, "D"), num(summary, "D_err"), num_at(summary, "msd_window", 0),
           num_at(summary, "msd_window", 1), num(summary, "dv"), num(summary, "dv_err"),
           num(summary, "psi"), num(summary, "psi_err"));
+    if (quiet)
+      dir->log_only(details);
+    else
+      fmt::print("{}", details);
     print_warnings(summary);
     return 0;
   } catch (const sheardiff::RunUnhealthy& e) {

@@ -6,21 +6,26 @@
 #include <pthread.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
+#include "sheardiff/io/text.hpp"
+#include "sheardiff/version.hpp"
 
 namespace sheardiff {
 
@@ -94,7 +99,8 @@ const std::vector<std::string>& run_file_names() {
 }
 
 // Copies what the process writes to fds 1 and 2 to where they went before and to the log, by
-// a thread reading two pipes: libraries (CHOLMOD's warnings) write to fd 2 directly.
+// a thread reading two pipes: libraries (CHOLMOD's warnings) write to fd 2 directly. A line
+// redrawn with '\r' (a terminal's live progress line) goes to the terminal only.
 class RunDirectory::OutputTee {
  public:
   explicit OutputTee(int log_fd) : log_fd_(log_fd) {
@@ -143,6 +149,30 @@ class RunDirectory::OutputTee {
   OutputTee(const OutputTee&) = delete;
   OutputTee& operator=(const OutputTee&) = delete;
 
+  // Whether stderr, before the tee, was a terminal.
+  bool terminal() const { return saved_[1] >= 0 && isatty(saved_[1]); }
+
+  // Appends `text` to the log only, after everything printed before it.
+  void log_only(std::string_view text) {
+    std::cout.flush();
+    std::fflush(stdout);
+    std::fflush(stderr);
+    // The pump reads and handles each chunk under the mutex: with the mutex held and both
+    // pipes empty, all that was printed before is in the log.
+    for (;;) {
+      std::unique_lock lock(mutex_);
+      int waiting[2] = {0, 0};
+      for (int k = 0; k < 2; ++k)
+        if (ioctl(read_[k], FIONREAD, &waiting[k]) != 0) waiting[k] = 0;
+      if (waiting[0] == 0 && waiting[1] == 0) {
+        write_all(log_fd_, text.data(), text.size());
+        return;
+      }
+      lock.unlock();
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  }
+
  private:
   void pump() {
     pollfd fds[2] = {{read_[0], POLLIN, 0}, {read_[1], POLLIN, 0}};
@@ -155,24 +185,29 @@ class RunDirectory::OutputTee {
       }
       for (int k = 0; k < 2; ++k) {
         if (fds[k].fd < 0 || fds[k].revents == 0) continue;
+        const std::lock_guard lock(mutex_);
         const ssize_t n = ::read(fds[k].fd, buf, sizeof buf);
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) {
-          if (!line_[k].empty()) log_line(k);
+          if (!line_[k].empty() && !live_[k]) log_line(k);
           fds[k].fd = -1;
           --open;
           continue;
         }
         if (saved_[k] >= 0) write_all(saved_[k], buf, static_cast<std::size_t>(n));
-        // The log keeps what a terminal would end up showing: a progress line redrawn after
-        // '\r' twice a second is logged once, as it ends.
+        // A line redrawn after '\r' (a terminal's live progress, twice a second) is not
+        // logged: the log gets timestamped progress lines instead (simulation.cpp).
         for (ssize_t i = 0; i < n; ++i) {
-          if (buf[i] == '\r')
+          if (buf[i] == '\r') {
             line_[k].clear();
-          else if (buf[i] == '\n')
-            log_line(k);
-          else
+            live_[k] = true;
+          } else if (buf[i] == '\n') {
+            if (!live_[k]) log_line(k);
+            line_[k].clear();
+            live_[k] = false;
+          } else {
             line_[k] += buf[i];
+          }
         }
       }
     }
@@ -187,6 +222,8 @@ class RunDirectory::OutputTee {
   int saved_[2] = {-1, -1};
   int read_[2] = {-1, -1};
   std::string line_[2];
+  bool live_[2] = {false, false};  // the line being read began with '\r'
+  std::mutex mutex_;               // held by the pump while it handles a chunk
   std::thread thread_;
 };
 
@@ -270,21 +307,25 @@ void RunDirectory::start_log(const std::string& header) {
   if (tee_) return;
   const int log_fd = ::open(file(kLog).c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw_io_error("open", file(kLog));
-  const std::time_t now = std::time(nullptr);
-  char when[64];
-  std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S %z", std::localtime(&now));
-  char host[256] = "?";
-  gethostname(host, sizeof host - 1);
   // A log cut off mid-line (a full disk, a kill) gets its line ended first.
   char last = '\n';
   const off_t size = lseek(log_fd, 0, SEEK_END);
   if (size > 0 && pread(log_fd, &last, 1, size - 1) != 1) last = '\n';
-  const std::string line = fmt::format("{}=== {} on {}, pid {}: {}\n", last == '\n' ? "" : "\n",
-                                       when, host, static_cast<long>(getpid()), header);
+  const std::string line =
+      fmt::format("{}=== {} on {}, pid {}, {}: {}\n", last == '\n' ? "" : "\n", iso8601_utc_now(),
+                  host_name(), static_cast<long>(getpid()), version_line(), header);
   write_all(log_fd, line.data(), line.size());
   hdf5_log_file_ = fdopen(fcntl(log_fd, F_DUPFD_CLOEXEC, 3), "a");
   if (hdf5_log_file_ != nullptr) hdf5_log_ = std::make_unique<Hdf5ErrorLog>(hdf5_log_file_);
   tee_ = std::make_unique<OutputTee>(log_fd);
+}
+
+bool RunDirectory::terminal() const {
+  return tee_ ? tee_->terminal() : isatty(STDERR_FILENO) != 0;
+}
+
+void RunDirectory::log_only(std::string_view text) {
+  if (tee_) tee_->log_only(text);
 }
 
 void RunDirectory::with_hdf5_reasons(const std::function<void()>& f) const {

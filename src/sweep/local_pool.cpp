@@ -19,6 +19,7 @@
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
+#include "sheardiff/io/text.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
@@ -69,14 +70,6 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_d
 
 namespace {
 
-std::string duration_text(double s) {
-  if (!(s >= 0) || s > 1e8) return "?";
-  const long t = std::lround(s);
-  if (t >= 3600) return fmt::format("{}h{:02d}m", t / 3600, (t % 3600) / 60);
-  if (t >= 60) return fmt::format("{}m{:02d}s", t / 60, t % 60);
-  return fmt::format("{}s", t);
-}
-
 struct Worker {
   const SweepPoint* point;
   std::chrono::steady_clock::time_point started;
@@ -109,7 +102,8 @@ std::string oversubscription_warning(int jobs, int threads_per_job, int cores) {
       jobs, threads_per_job, static_cast<long>(jobs) * threads_per_job, cores, fit);
 }
 
-int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe) {
+int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
+              bool progress_lines) {
   const auto points = expand_points(spec);
   fs::create_directories(out_dir / "points");
   fs::create_directories(out_dir / "logs");
@@ -142,6 +136,9 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
   sigset_t child_mask;
   sigemptyset(&child_mask);
 
+  // Off a terminal (a batch log), the pool's lines start with an ISO 8601 UTC timestamp.
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  const auto stamp = [tty] { return tty ? std::string() : iso8601_utc_now() + "  "; };
   std::map<pid_t, Worker> running;
   long done = 0, failed = 0;
   double done_cost = 0, done_seconds = 0;
@@ -192,8 +189,8 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
         done_seconds += secs;
       } else if (!stop_signal) {
         ++failed;
-        fmt::print(stderr, "sweep: point {} failed (exit {}) after {}; see {}\n", p.name, code,
-                   duration_text(secs), (out_dir / "logs" / (p.name + ".log")).string());
+        fmt::print(stderr, "{}sweep: point {} failed (exit {}) after {}; see {}\n", stamp(), p.name,
+                   code, duration_text(secs), (out_dir / "logs" / (p.name + ".log")).string());
       }
       running.erase(it);
       changed = true;
@@ -201,6 +198,7 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
   };
 
   const auto progress = [&] {
+    if (!progress_lines) return;
     const auto now = std::chrono::steady_clock::now();
     if (!changed && now - last_print < std::chrono::seconds(30)) return;
     const double elapsed = std::chrono::duration<double>(now - t0).count();
@@ -218,10 +216,10 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
       eta = duration_text(left / jobs);
     }
     fmt::print(stderr,
-               "sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
+               "{}sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
                "{} elapsed, ETA {}\n",
-               finished_before + done, points.size(), finished_before, failed, running.size(),
-               todo.size(), duration_text(elapsed), eta);
+               stamp(), finished_before + done, points.size(), finished_before, failed,
+               running.size(), todo.size(), duration_text(elapsed), eta);
     last_print = now;
     changed = false;
   };
@@ -238,13 +236,14 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
     const int sig = sigtimedwait(&mask, nullptr, &wait);
     if ((sig == SIGINT || sig == SIGTERM) && !stop_signal) {
       stop_signal = sig;
-      fmt::print(stderr, "sweep: signal {}: stopping {} running point(s) at their checkpoint\n",
-                 sig, running.size());
+      fmt::print(stderr, "{}sweep: signal {}: stopping {} running point(s) at their checkpoint\n",
+                 stamp(), sig, running.size());
       for (const auto& [pid, w] : running) kill(pid, SIGTERM);
     }
     reap();
     if (stop_signal && running.empty()) break;
   }
+  if (!stop_signal) progress();  // the last line: every point done, when
   sigprocmask(SIG_SETMASK, &old_mask, nullptr);
   if (stop_signal)
     throw RunInterrupted(stop_signal,

@@ -1,5 +1,6 @@
 // Kill-and-resume: a run killed at a random moment (SIGKILL) or stopped by SIGTERM and resumed
 // from its checkpoint ends in the same state, to the bit, as a run that was never stopped.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -10,19 +11,25 @@
 #include <fstream>
 #include <iterator>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <thread>
 
 #include "sheardiff/core/archive.hpp"
+#include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/text.hpp"
 #include "sheardiff/simulation.hpp"
+#include "sheardiff/version.hpp"
 
 namespace sheardiff {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path binary() { return fs::canonical("/proc/self/exe").parent_path().parent_path() / "sheardiff"; }
+fs::path binary() {
+  return fs::canonical("/proc/self/exe").parent_path().parent_path() / "sheardiff";
+}
 
 // A small pressure-cell run with every observer on, long enough to be killed in the middle.
 fs::path write_config(const fs::path& dir) {
@@ -116,8 +123,9 @@ void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_cou
                           "dv", "psi", "steady_strain", "pressure_max_relative_error"})
     EXPECT_EQ(sa[key], sb[key]) << key;
   // The whole summary but the clock (issue 16: the solver's work counters, factorisations,
-  // restarted from 0 at a resume).
-  for (const char* clock : {"wall_seconds", "ms_per_step"}) sa.erase(clock), sb.erase(clock);
+  // restarted from 0 at a resume) and the dates (two runs).
+  for (const char* clock : {"wall_seconds", "ms_per_step", "started", "finished"})
+    sa.erase(clock), sb.erase(clock);
   if (!with_counters) sa.erase("factorisations"), sb.erase("factorisations");
   EXPECT_EQ(sa, sb);
   EXPECT_FALSE(fs::exists(b / "checkpoint.bin")) << "a finished run keeps no checkpoint";
@@ -135,13 +143,15 @@ TEST(Checkpoint, SigkillAtRandomMomentThenResumeIsBitIdentical) {
   // resume and a user would simply start again).
   for (int k = 0; k < 2000 && !fs::exists(root / "killed" / "checkpoint.bin"); ++k)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(0, 400)(rng)));
+  std::this_thread::sleep_for(
+      std::chrono::milliseconds(std::uniform_int_distribution<int>(0, 400)(rng)));
   kill(pid, SIGKILL);
   const int killed = wait_exit(pid);
   if (killed == 0) GTEST_SKIP() << "the run finished before the kill landed (machine too fast)";
   ASSERT_EQ(killed, 128 + SIGKILL);
   ASSERT_TRUE(fs::exists(root / "killed" / "checkpoint.bin"));
-  EXPECT_FALSE(fs::exists(root / "killed" / "summary.json")) << "a killed run must not look finished";
+  EXPECT_FALSE(fs::exists(root / "killed" / "summary.json"))
+      << "a killed run must not look finished";
 
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "killed")), 0);
   expect_same_final_state(root / "whole", root / "killed");
@@ -271,7 +281,8 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
   const std::vector<char> v3 = bytes_of(root / "old" / "checkpoint.bin");
-  const std::size_t header = 8 + 22 + 8 + 4, counters = 4 * sizeof(std::size_t);
+  // Version 3 payloads end with the counters and, since issue 17, the start time.
+  const std::size_t header = 8 + 22 + 8 + 4, counters = 4 * sizeof(std::size_t) + 8;
   ASSERT_GT(v3.size(), header + counters);
   std::vector<char> v2(8);
   const std::uint64_t magic_length = 22;
@@ -283,6 +294,77 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0);
   EXPECT_NE(text_of(root / "err.txt").find("has no checksum"), std::string::npos);
   expect_same_final_state(root / "whole", root / "old", /*with_counters=*/false);
+  fs::remove_all(root);
+}
+
+// Issue 17: the summary says when the run started, its first start for a resumed run (kept in
+// the checkpoint), and when it finished, in ISO 8601 UTC, with the version, host and seed.
+TEST(Checkpoint, ResumedRunKeepsItsStartTime) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_started";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  make_interrupted_run(cfg, root / "run");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  const std::string resumed_at = iso8601_utc_now();
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "run")), 0);
+  nlohmann::json js;
+  std::ifstream(root / "run" / "summary.json") >> js;
+  const std::regex iso(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)");
+  ASSERT_TRUE(js["started"].is_string()) << js.dump(2);
+  EXPECT_TRUE(std::regex_match(js["started"].get<std::string>(), iso)) << js["started"];
+  EXPECT_TRUE(std::regex_match(js["finished"].get<std::string>(), iso)) << js["finished"];
+  EXPECT_LT(js["started"].get<std::string>(), resumed_at) << "the start of the resume, not the run";
+  EXPECT_GE(js["finished"].get<std::string>(), resumed_at);
+  EXPECT_EQ(js["seed"], 4);
+  EXPECT_EQ(js["version"], version());
+  EXPECT_EQ(js["git_hash"], git_hash());
+  EXPECT_EQ(js["host"], host_name());
+  fs::remove_all(root);
+}
+
+// A checkpoint of the sheardiff before issue 17 holds its configuration with 17-digit floats
+// (phi_init = 0.71999999999999997) and no start time: it resumes to the same results, the
+// start unknown (null), rather than being refused as another configuration.
+TEST(Checkpoint, CheckpointWithOldFloatTextStillResumes) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_old_text";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
+  make_interrupted_run(cfg, root / "old");
+  std::vector<char> payload = read_checkpoint_file(root / "old" / "checkpoint.bin").bytes;
+  // The payload starts with the resolved configuration (a length and the text).
+  Archive a = Archive::reader(payload);
+  std::string text;
+  a.io(text);
+  const std::size_t rest = 8 + text.size();
+  std::istringstream lines(text);
+  std::string old_text;
+  int rewritten = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const auto eq = line.find(" = ");
+    if (eq != std::string::npos && line.find('.', eq) != std::string::npos && line[eq + 3] != '"') {
+      const double x = std::strtod(line.c_str() + eq + 3, nullptr);
+      const std::string long_form = fmt::format("{:.17g}", x);
+      rewritten += long_form != line.substr(eq + 3);
+      line = line.substr(0, eq + 3) + long_form;
+    }
+    old_text += line + "\n";
+  }
+  ASSERT_GT(rewritten, 5) << old_text;
+  ASSERT_NE(old_text.find("phi_init = 0.71999999999999997"), std::string::npos) << old_text;
+  Archive w = Archive::writer();
+  w.io(old_text);
+  std::vector<char> old_payload = w.bytes();
+  old_payload.insert(old_payload.end(), payload.begin() + static_cast<long>(rest),
+                     payload.end() - 8);  // without the start time
+  const std::vector<char> file = checkpoint_file_bytes(old_payload);
+  write_bytes(root / "old" / "checkpoint.bin", file);
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0)
+      << text_of(root / "err.txt");
+  expect_same_final_state(root / "whole", root / "old");
+  nlohmann::json js;
+  std::ifstream(root / "old" / "summary.json") >> js;
+  EXPECT_TRUE(js["started"].is_null()) << js["started"];
   fs::remove_all(root);
 }
 

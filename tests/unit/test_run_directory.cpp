@@ -1,11 +1,13 @@
 // Run directories (issue 16): the lock, the states, the log, and atomic writes that name the
 // file and the operating system's reason.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <regex>
 #include <sstream>
 
 #include "sheardiff/config.hpp"
@@ -77,7 +79,10 @@ TEST(RunDirectory, StateFollowsTheFilesOfARun) {
   fs::remove_all(dir);
 }
 
-TEST(RunDirectory, LogHoldsWhatWasPrintedAsATerminalShowsIt) {
+// The log holds what was printed, but not a terminal's live line (redrawn after '\r'): the
+// run logs timestamped progress lines instead (issue 17). Its header says when (ISO 8601 UTC),
+// where and which sheardiff.
+TEST(RunDirectory, LogHoldsWhatWasPrintedButNotTheLiveLine) {
   const auto dir = fresh_dir("log");
   {
     RunDirectory d(dir, true);
@@ -88,13 +93,53 @@ TEST(RunDirectory, LogHoldsWhatWasPrintedAsATerminalShowsIt) {
     std::fprintf(stderr, "error: the last words");  // no newline: kept anyway
   }
   const std::string log = text_of(dir / "run.log");
-  EXPECT_NE(log.find("pid " + std::to_string(getpid()) + ": the header\n"), std::string::npos)
+  EXPECT_TRUE(std::regex_search(
+      log,
+      std::regex(R"(^=== \d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ on \S+, pid )" + std::to_string(getpid()) +
+                 R"(, sheardiff \d+\.\d+\.\d+ \(git \S+\): the header\n)")))
       << log;
-  EXPECT_NE(log.find("strain 0.3   \n"), std::string::npos) << log;
-  EXPECT_EQ(log.find("strain 0.1"), std::string::npos) << "redrawn lines are logged once: " << log;
+  EXPECT_EQ(log.find("strain 0."), std::string::npos) << "a live line was logged: " << log;
   EXPECT_NE(log.find("a result\n"), std::string::npos) << log;
   EXPECT_NE(log.find("another result\n"), std::string::npos) << log;
   EXPECT_NE(log.find("error: the last words"), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
+// log_only: in the log, in order with what was printed, and not on the terminal (--quiet's
+// result lines, the progress lines of a run on a terminal).
+TEST(RunDirectory, LogOnlyTextKeepsItsPlaceAndStaysOffTheTerminal) {
+  const auto dir = fresh_dir("log_only");
+  fs::create_directories(dir);
+  const auto screen = dir / "screen.txt";
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const int saved_out = dup(1), saved_err = dup(2);
+  {
+    // The "terminal" is a file, in place of fds 1 and 2 while the log runs.
+    std::FILE* f = std::fopen(screen.c_str(), "w");
+    dup2(fileno(f), 1);
+    dup2(fileno(f), 2);
+    std::fclose(f);
+    RunDirectory d(dir / "run", true);
+    d.start_log("order");
+    EXPECT_FALSE(d.terminal());
+    for (int k = 0; k < 50; ++k) {
+      std::fprintf(stdout, "printed %d\n", k);
+      d.log_only(fmt::format("logged {}\n", k));
+    }
+  }
+  std::fflush(stdout);
+  dup2(saved_out, 1);
+  dup2(saved_err, 2);
+  close(saved_out);
+  close(saved_err);
+  std::string want;
+  for (int k = 0; k < 50; ++k) want += fmt::format("printed {}\nlogged {}\n", k, k);
+  const std::string log = text_of(dir / "run" / "run.log");
+  EXPECT_EQ(log.substr(log.find('\n') + 1), want);
+  const std::string shown = text_of(screen);
+  EXPECT_EQ(shown.find("logged"), std::string::npos) << shown;
+  EXPECT_NE(shown.find("printed 49\n"), std::string::npos) << shown;
   fs::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace sheardiff {
@@ -44,11 +45,18 @@ class RunDirectory {
   void remove_partial_files();
 
   // From now until destruction, what the process writes to stdout and stderr also goes to
-  // DIR/run.log (appended; a line rewritten with '\r' is logged as it ends), and so do HDF5's
-  // error stacks (instead of the terminal). `header` opens this command's part of the log.
+  // DIR/run.log (appended; a line redrawn with '\r', a terminal's live progress line, is not
+  // logged), and so do HDF5's error stacks (instead of the terminal). `header` opens this
+  // command's part of the log: "=== TIME (ISO 8601 UTC) on HOST, pid PID, sheardiff VERSION
+  // (git HASH): header".
   void start_log(const std::string& header);
   // Whether start_log was called: this command has taken charge of DIR.
   bool logging() const { return tee_ != nullptr; }
+  // Whether the command's stderr (before start_log redirected it) is a terminal.
+  bool terminal() const;
+  // Appends text to run.log only, not to the terminal, in order after what was printed before
+  // (nothing before start_log).
+  void log_only(std::string_view text);
   // HDF5 errors seen since start_log (null before it).
   const Hdf5ErrorLog* hdf5_log() const { return hdf5_log_.get(); }
   // Runs f. Some writers (analysis.h5) report a failed HDF5 write as a bare runtime_error: one

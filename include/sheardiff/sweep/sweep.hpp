@@ -60,11 +60,12 @@ PointState point_state(const SweepSpec& spec, const SweepPoint& p,
 // Throws what run_to_directory throws.
 void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
 
-// Local backend: `jobs` worker processes of `exe sweep FILE --out DIR --point I`, a progress
-// line on stderr, SIGINT/SIGTERM forwarded (workers checkpoint). Returns the number of failed
-// points (the command then exits 3); throws RunInterrupted on a signal.
+// Local backend: `jobs` worker processes of `exe sweep FILE --out DIR --point I`, progress
+// lines on stderr if `progress` (with an ISO 8601 UTC timestamp off a terminal), SIGINT/SIGTERM
+// forwarded (workers checkpoint). Returns the number of failed points (the command then exits
+// 3); throws RunInterrupted on a signal.
 int run_local(const SweepSpec& spec, const std::filesystem::path& out_dir, int jobs,
-              const std::filesystem::path& exe);
+              const std::filesystem::path& exe, bool progress = true);
 
 // The local pool's oversubscription check (docs/performance.md, "Threads"): workers x threads
 // per worker (OMP_THREAD_LIMIT) above the cores this process may use makes every point slower
