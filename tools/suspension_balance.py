@@ -570,8 +570,12 @@ def main(argv=None):
         plot_case(a.plot, a.out, a.length_scale)
         return 0
     if a.solve:
-        m = suspension_balance(a.solve[0], a.solve[1], npts=a.npts, length_scale=a.length_scale)
-        d = diffusive_flux(a.solve[0])
+        try:
+            m = suspension_balance(a.solve[0], a.solve[1], npts=a.npts, length_scale=a.length_scale)
+            d = diffusive_flux(a.solve[0])
+        except (ValueError, RuntimeError) as e:
+            print(f"suspension_balance.py: {e}", file=sys.stderr)
+            return 1
         for name, p in (("suspension balance", m), ("diffusive flux", d)):
             print(f"{name}: u_c {p.u_c:.4f}  phi_c {p.phi_c:.4f}  u_p {p.u_p:.4f}  Q_p {p.Q_p:.4f}  "
                   f"dp ratio {p.dp_ratio:.4f}" + (f"  T_c {p.T[0]:.4g}" if p.T is not None else ""))
