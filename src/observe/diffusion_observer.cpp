@@ -7,6 +7,8 @@
 
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/text.hpp"
+#include "sheardiff/version.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 
 namespace sheardiff {
@@ -161,7 +163,9 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
                           cfg.observables.wall_exclusion);
   }
   write_analysis_file(r, dir / "analysis.h5");
-  write_file_atomically(dir / "summary.json", js.dump(2) + "\n");
+  // The run's own version stays; the analysis says which code recomputed it.
+  js["analysed_by"] = version_line();
+  write_file_atomically(dir / "summary.json", json_text(js) + "\n");
   return js;
 }
 

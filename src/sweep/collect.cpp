@@ -12,6 +12,7 @@
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/text.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {
@@ -353,8 +354,8 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
     }
     fits["groups"].push_back({{"axes", group_axes[key]}, {"rows", rows}, {"fits", group_fits}});
   }
-  write_file_atomically(out_dir / "fits.json", fits.dump(2) + "\n");
-  if (!spec.results.empty()) write_file_atomically(spec.results / "fits.json", fits.dump(2) + "\n");
+  write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
+  if (!spec.results.empty()) write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
   return fits;
 }
 
