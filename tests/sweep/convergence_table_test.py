@@ -1,0 +1,41 @@
+#!/usr/bin/python3
+"""tools/convergence_table.py on a synthetic sweep.csv with a known answer: three values of a
+setting, four seeds each; the coarsest carries a bias of exactly 4 reference standard errors in
+dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
+seed values), and an unknown axis must be refused. Usage: convergence_table_test.py REPO WORK"""
+import csv
+import pathlib
+import subprocess
+import sys
+
+repo, work = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+work.mkdir(parents=True, exist_ok=True)
+cols = ["point", "status", "axis.integrator.max_displacement", "axis.run.seed", "phi", "mu", "dv",
+        "psi", "D", "max_overlap", "steps_per_strain", "wall_seconds", "strain"]
+# reference dv over seeds: 3.0 +- (0.1, -0.1, 0.1, -0.1): mean 3.0, sem = 0.1/sqrt(4) * sqrt(4/3)
+offsets = [0.1, -0.1, 0.1, -0.1]
+sem = (sum(o * o for o in offsets) / 3 / 4) ** 0.5
+rows = []
+for md, bias in [(3e-4, 0.0), (1e-3, 0.0), (3e-3, 4 * sem)]:
+    for s, o in enumerate(offsets, 1):
+        rows.append({"point": f"md={md}_seed={s}", "status": "done",
+                     "axis.integrator.max_displacement": md, "axis.run.seed": s, "phi": 0.8,
+                     "mu": 0.28 + o / 10, "dv": 3.0 + o + bias, "psi": 0.02 + o / 100,
+                     "D": 0.2 + o / 10, "max_overlap": 0.003, "steps_per_strain": 1e4 / md * 1e-3,
+                     "wall_seconds": 100.0, "strain": 10.0})
+with open(work / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=cols)
+    w.writeheader()
+    w.writerows(rows)
+tool = [sys.executable, str(repo / "tools/convergence_table.py"), str(work)]
+out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.003 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[4].endswith(", +4.0)"), f"dv cell {cells[4]!r}: want r = +4.0"
+assert "(" not in cells[2], f"phi cell {cells[2]!r}: equal seeds have no error, no ratio"
+line = next(l for l in out.splitlines() if l.startswith("| 0.001 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[4].endswith("(+0.0, +0.0)"), f"dv cell {cells[4]!r}: want no bias"
+bad = subprocess.run(tool + ["--axis", "flow.J"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--axis" in bad.stderr, bad.stderr
+print("convergence_table: ok")

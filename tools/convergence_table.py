@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""Is a numerical setting converged for what a sweep reports? A markdown table from a sweep's
+sweep.csv (a sweep folder, or the store results/<name>/ that `sheardiff sweep ... --collect`
+writes) whose points vary one setting (the axis, e.g. integrator.max_displacement) over several
+seeds.
+
+Per value of the axis: the mean over seeds of phi, mu, dv, Psi, D and the largest overlap, each
++- the standard error of that mean from the seeds' scatter, the cost (steps and run seconds per
+strain), and each quantity's difference from the reference value of the axis (default: the
+smallest) in two units:
+  * z   = difference / combined standard error: |z| > 2 is a resolved bias;
+  * r   = difference / the reference's standard error: the accuracy criterion of
+          docs/performance.md is |r| <= 1/2 (within half the statistical error). With a few
+          seeds this r is itself noisy (its own error is ~ sqrt(2) / 1 in these units), so the
+          table reports it and z, and the verdict needs both.
+
+    /usr/bin/python3 tools/convergence_table.py DIR [--axis KEY] [--reference VALUE]
+"""
+import argparse
+import csv
+import math
+import pathlib
+import sys
+
+QUANTITIES = [("phi", "phi"), ("mu", "mu"), ("dv", "dv / (gammadot d)"),
+              ("psi", "Psi gammadot"), ("D", "D / (gammadot d^2)"),
+              ("max_overlap", "largest overlap / d")]
+
+
+def mean_sem(xs):
+    n = len(xs)
+    if n == 0:
+        return None, None
+    m = sum(xs) / n
+    if n < 2:
+        return m, None
+    var = sum((x - m) ** 2 for x in xs) / (n - 1)
+    return m, math.sqrt(var / n)
+
+
+def g(x, p=3):
+    return "-" if x is None else f"{x:.{p}g}"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("dir")
+    ap.add_argument("--axis", help="the setting that varies (default: the one axis that is not "
+                    "run.seed)")
+    ap.add_argument("--reference", type=float, help="the converged value of the axis (default: "
+                    "the smallest)")
+    a = ap.parse_args()
+    path = pathlib.Path(a.dir) / "sweep.csv"
+    if not path.exists():
+        sys.exit(f"{path}: missing (run `sheardiff sweep SWEEP.toml --out DIR --collect` first)")
+    rows = [r for r in csv.DictReader(open(path)) if r["status"].startswith("done")]
+    if not rows:
+        sys.exit(f"{path}: no finished points yet")
+    axes = [k[len("axis."):] for k in rows[0] if k.startswith("axis.") and k != "axis.run.seed"]
+    axis = a.axis or (axes[0] if len(axes) == 1 else None)
+    if axis is None or f"axis.{axis}" not in rows[0]:
+        sys.exit(f"{path}: give --axis, one of {axes}")
+    groups = {}
+    for r in rows:
+        groups.setdefault(float(r[f"axis.{axis}"]), []).append(r)
+    ref_value = a.reference if a.reference is not None else min(groups)
+    if ref_value not in groups:
+        sys.exit(f"--reference {ref_value}: no finished point has {axis} = {ref_value}")
+
+    def stats(rs, q):
+        return mean_sem([float(r[q]) for r in rs if r.get(q) not in (None, "")])
+
+    ref = {q: stats(groups[ref_value], q) for q, _ in QUANTITIES}
+    print(f"{sum(len(v) for v in groups.values())} finished points; axis {axis}, reference "
+          f"{ref_value:g}. Cells: mean over seeds +- standard error of the mean; "
+          f"(z, r) = difference from the reference in combined standard errors and in the "
+          f"reference's standard error.\n")
+    print("| " + axis + " | seeds | " + " | ".join(h for _, h in QUANTITIES)
+          + " | steps / strain | run s / strain |")
+    print("|---" * (len(QUANTITIES) + 4) + "|")
+    for v in sorted(groups, reverse=True):
+        rs = groups[v]
+        cells = []
+        for q, _ in QUANTITIES:
+            m, e = stats(rs, q)
+            cell = g(m, 4) + (f" +- {e:.2g}" if e is not None else "")
+            rm, re = ref[q]
+            if v != ref_value and m is not None and rm is not None and re:
+                comb = math.hypot(e or 0.0, re)
+                cell += f" ({(m - rm) / comb:+.1f}, {(m - rm) / re:+.1f})"
+            cells.append(cell)
+        steps, _ = stats(rs, "steps_per_strain")
+        secs = mean_sem([float(r["wall_seconds"]) / float(r["strain"]) for r in rs
+                         if r.get("wall_seconds") and r.get("strain")])[0]
+        print(f"| {v:g} | {len(rs)} | " + " | ".join(cells) + f" | {g(steps)} | {g(secs)} |")
+
+
+if __name__ == "__main__":
+    main()
