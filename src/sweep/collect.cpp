@@ -156,6 +156,9 @@ json fit_group(const std::vector<json>& rows) {
 // Fit errors from the scatter between seeds: every replicate draws, at each J, as many runs as
 // there are with replacement, averages them, and refits. Returns {fit: {param: sd}} over the
 // replicates (null where a fit failed in more than 5 % of them or there is one run per J).
+// The plain bootstrap's variance of an n-run mean is (n - 1)/n times the unbiased s^2/n: half
+// of it with the two or three seeds a sweep affords. So each J's runs are drawn about their mean
+// with deviations widened by sqrt(n / (n - 1)), which makes a replicate mean's variance s^2/n.
 json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replicates) {
   bool several = false;
   for (const auto& [j, runs] : by_j) several = several || runs.size() > 1;
@@ -171,10 +174,19 @@ json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replic
       std::vector<std::size_t> pick;
       for (std::size_t k = 0; k < runs.size(); ++k) pick.push_back(rng() % runs.size());
       for (const char* q : {"phi", "mu", "D", "dv", "psi"}) {
+        double mean = 0;
+        long n_all = 0;
+        for (const auto& run : runs)
+          if (const double v = num(run, q); std::isfinite(v)) mean += v, ++n_all;
+        mean /= static_cast<double>(std::max(n_all, 1L));
+        const double widen =
+            n_all > 1 ? std::sqrt(static_cast<double>(n_all) / static_cast<double>(n_all - 1))
+                      : 1.0;
         double sum = 0;
         long n = 0;
         for (std::size_t k : pick)
-          if (const double v = num(runs[k], q); std::isfinite(v)) sum += v, ++n;
+          if (const double v = num(runs[k], q); std::isfinite(v))
+            sum += mean + widen * (v - mean), ++n;
         row[q] = n > 0 ? json(sum / static_cast<double>(n)) : json(nullptr);
       }
       rows.push_back(row);

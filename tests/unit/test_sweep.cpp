@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/sweep/sweep.hpp"
@@ -257,4 +258,32 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
   std::ofstream(spec.results / "points" / points[0].name / "config.toml")
       << to_toml(load_config(spec.base, points[5].overrides));
   EXPECT_THROW(stored_point(spec, points[0]), ConfigError);
+}
+
+// The seeds' bootstrap quotes the unbiased standard error even with two seeds per J. Three J
+// (1e-3, 1e-2, 1e-1) on an exact D = J^-1/4, two seeds each; only J = 0.1 scatters, by
+// D (1 +- eps). The log-log slope through three equally spaced points is (y_3 - y_1) / 2, so its
+// error is that of log10 of the J = 0.1 mean over 2: s.e.m. of that mean = eps D (unbiased:
+// s^2/n = 2 eps^2 D^2 / 2), hence sd(b) = eps / (2 ln 10). The plain bootstrap would give 1/sqrt(2)
+// of it (0.71): the tolerance (5 %) is the sampling error of 2000 replicates, several times over.
+TEST(Sweep, SeedBootstrapQuotesTheUnbiasedErrorWithTwoSeeds) {
+  const double eps = 0.01;
+  std::map<double, std::vector<nlohmann::json>> by_j;
+  for (double J : {1e-3, 1e-2, 1e-1}) {
+    const double d = std::pow(J, -0.25);
+    for (double sign : {+1.0, -1.0}) {
+      const double f = J == 1e-1 ? 1.0 + sign * eps : 1.0;
+      by_j[J].push_back({{"phi", 0.8 - 0.6 * std::sqrt(J)},
+                         {"mu", 0.3 + J},
+                         {"D", d * f},
+                         {"dv", 0.3 * d},
+                         {"psi", 0.3 / d}});
+    }
+  }
+  const auto boot = seed_bootstrap(by_j, 2000);
+  const double want = eps / (2.0 * std::log(10.0));
+  ASSERT_TRUE(boot.contains("D_vs_J"));
+  EXPECT_NEAR(boot["D_vs_J"]["b"].get<double>(), want, 0.05 * want);
+  // dv did not scatter: no error there.
+  EXPECT_LT(boot["dv_vs_J"]["b"].get<double>(), 1e-12);
 }

@@ -3,6 +3,7 @@
 // points, the local process pool, the Slurm job array, and the collection into sweep.csv and
 // fits.json. Every point is an ordinary run directory DIR/points/<name>/ (docs/sweeps.md).
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -95,5 +96,11 @@ nlohmann::json collect_sweep(const SweepSpec& spec, const std::filesystem::path&
 // against phi_c - phi, phi(J) = phi_c - a J^b and mu(J) = mu_c + a J^b. rows: one per J, keys
 // J, phi, mu, D, dv, psi (seeds already averaged). Fits that lack points hold {"error": why}.
 nlohmann::json fit_group(const std::vector<nlohmann::json>& rows);
+
+// Standard deviations of every fit parameter over `replicates` bootstrap draws of the seeds at
+// each J (runs keyed by J; each run a summary with phi, mu, D, dv, psi), with the small-sample
+// correction described in collect.cpp. Empty when every J has one run.
+nlohmann::json seed_bootstrap(const std::map<double, std::vector<nlohmann::json>>& by_j,
+                              long replicates);
 
 }  // namespace sheardiff
