@@ -31,48 +31,17 @@
 
 namespace sheardiff {
 
-namespace {
-
-std::optional<Lubrication> lubrication_of(const Config& cfg) {
-  if (!cfg.lubrication.enabled) return std::nullopt;
-  return Lubrication{cfg.lubrication.delta, cfg.lubrication.h_max, cfg.lubrication.tangential};
-}
-
-FrictionalContact contact_of(const Config& cfg) {
-  const double kn = cfg.contact.ktilde;
-  return FrictionalContact{kn, cfg.contact.kt_ratio * kn, cfg.contact.mu,
-                           cfg.contact.stiffness == "mean_radius"};
-}
-
-}  // namespace
-
 double interaction_range_factor(const Config& cfg) {
-  return cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
+  return PairLaws::from(cfg).range_factor();
 }
 
 double explicit_stability_dt(const Config& cfg) {
-  // The fastest spring mode is the smallest pair (two small discs): its normal and slip
-  // modes relax at rate k / R with R the dashpot (lubrication at contact) plus the drag.
-  const double a = 0.5;
-  const double drag = 3.0 * kPi * 2.0 * a / 2.0;  // relative motion of two drag-bound discs
-  double rn = drag, rt = drag;
-  if (auto lub = lubrication_of(cfg)) {
-    const PairResistance r = lub->coefficients(a, a, 0.0);
-    rn += r.xa;
-    rt += r.ya;
-  }
-  const FrictionalContact c = contact_of(cfg);
-  double dt = 2.0 * rn / c.kn;
-  if (c.has_friction()) dt = std::min(dt, 2.0 * rt / c.kt);
-  return dt;
+  return PairLaws::from(cfg).explicit_stability_dt();
 }
 
 bool rotational_unknowns(const Config& cfg) {
-  if (cfg.solver.rotations == "always") return true;
-  // Rotation couples to translation only through friction and the tangential lubrication modes
-  // (which include the contact dashpots); without both, omega = omega_inf + T_ext / drag.
-  const bool tangential_lubrication = cfg.lubrication.enabled && cfg.lubrication.tangential;
-  return contact_of(cfg).has_friction() || tangential_lubrication;
+  // Without a law that couples rotation to translation, omega = omega_inf + T_ext / drag.
+  return cfg.solver.rotations == "always" || PairLaws::from(cfg).needs_rotations();
 }
 
 void validate_run_inputs(const Config& cfg, const std::string& origin) {
@@ -82,7 +51,8 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
       throw ConfigError(fmt::format(
           "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
           "eta/P of explicit springs (smallest pair, normal and slip modes, "
-          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < "
+          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use "
+          "integrator.dt < "
           "{:.3g}, integrator.dt = 0 (adaptive), or "
           "integrator.type = \"implicit\"",
           origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
@@ -113,7 +83,7 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
   // of the largest pair lets a disc meet its own image (ignored, so its stress is lost) or a
   // pair meet twice (one contact history for two images).
   const double cutoff = 2.0 * amax * interaction_range_factor(cfg) + cfg.neighbour.skin;
-  const bool periodic_y = cfg.scene.type == "simple_shear";
+  const bool periodic_y = scene_kind(cfg.scene.type).periodic_y;
   const double edge = periodic_y ? std::min(lx, ly) : lx;
   if (!(edge > 2.0 * cutoff))
     throw ConfigError(fmt::format(
@@ -140,7 +110,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = interaction_range_factor(cfg);
-  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), rotational_unknowns(cfg) ? 3 : 2,
+  ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
@@ -161,7 +131,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
   std::vector<std::unique_ptr<Observer>> obs;
   obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
   std::function<bool(const Dynamics&)> measuring;
-  if (cfg.scene.type == "pressure_shear") {
+  // A scene measured from its steady state has the pressure cell's detector of it.
+  if (scene_kind(cfg.scene.type).measured_from_steady_state) {
     auto cell = std::make_unique<PressureCellObserver>(cfg);
     const PressureCellObserver* c = cell.get();
     measuring = [c](const Dynamics&) { return c->steady(); };
