@@ -265,6 +265,10 @@ const std::vector<KeySpec>& schema() {
                      "pressure_shear: slab next to each wall left out of the bulk phi."));
     s.push_back(real("observables.profile_bin", &C::observables, &C::Observables::profile_bin, 0.0,
                      100.0, true, "d", "Bin width of the phi, u_x and T profiles across the gap."));
+    s.push_back(boolean("observables.profiles", &C::observables, &C::Observables::profiles,
+                        "Profiles across the gap of a scene with walls, over the measured window: "
+                        "phi, u_x, T = <u'.u'> and the pair stresses sigma_xy and p per bin "
+                        "(summary.json: profile_*). Off = they cost nothing."));
     s.push_back(boolean("analysis.diffusion", &C::analysis, &C::Analysis::diffusion,
                         "Self-diffusion analysis over the measured window (steady state, or "
                         "after run.transient_strain): MSD, D, dv, VACF, Psi; writes "

@@ -24,6 +24,7 @@
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/observe/stress.hpp"
 #include "sheardiff/run_parts.hpp"
@@ -131,7 +132,7 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
                                                       const std::filesystem::path& out_dir) {
   std::vector<std::unique_ptr<Observer>> obs;
   obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  std::function<bool(const Dynamics&)> measuring;
+  MeasuredWindow measuring;
   // A scene measured from its steady state has the pressure cell's detector of it.
   if (scene_kind(cfg.scene.type).measured_from_steady_state) {
     auto cell = std::make_unique<PressureCellObserver>(cfg);
@@ -142,6 +143,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
     const double from = cfg.run.transient_strain;
     measuring = [from](const Dynamics& d) { return d.strain() > from; };
   }
+  if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
+    obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
   if (cfg.analysis.diffusion)
     obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / "analysis.h5", measuring));
   return obs;

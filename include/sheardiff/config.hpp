@@ -85,6 +85,7 @@ struct Config {
   struct Observables {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi
     double profile_bin = 0.5;     // d, bin width of the profiles across the gap
+    bool profiles = true;         // profiles across the gap (scenes with walls)
   } observables;
   struct Analysis {
     bool diffusion = true;        // MSD, VACF, dv, Psi, D over the measured window

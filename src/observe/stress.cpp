@@ -74,8 +74,8 @@ ContactNetwork contact_network(const Dynamics& d) {
   for (const Pair& pr : d.neighbours().pairs()) {
     if (!pr.history.touching) continue;
     // Geometry of now, not of the last solve: the frame shows the positions of now.
-    const Vec2 rij = p.position[pr.j] + d.box().image_shift(pr.kx, pr.ky) - p.position[pr.i];
-    const PairGeometry g = PairGeometry::make(rij, p.radius[pr.i], p.radius[pr.j]);
+    const PairGeometry g =
+        PairGeometry::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
     c.pairs.push_back({pr.i, pr.j});
     c.normal_force.push_back(law.kn_of(g) * std::max(g.overlap(), 0.0));
     c.tangential_force.push_back(-law.kt_of(g) *

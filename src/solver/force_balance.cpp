@@ -5,11 +5,8 @@
 namespace sheardiff {
 
 namespace {
-Vec2 pair_vector(const Particles& p, const Box& box, const Pair& pr) {
-  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
-}
 PairGeometry pair_geometry(const Particles& p, const Box& box, const Pair& pr) {
-  return PairGeometry::make(pair_vector(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+  return PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
 }
 }  // namespace
 
@@ -26,7 +23,7 @@ void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs
 
 void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs) {
   for (Pair& pr : pairs) {
-    const double r = pair_vector(p, box, pr).norm();
+    const double r = pair_separation(p, box, pr).norm();
     const bool touching = r <= p.radius[pr.i] + p.radius[pr.j];
     if (touching != pr.history.touching) pr.history = PairHistory{touching, {}};
   }
@@ -79,7 +76,7 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box, const Impo
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
-    term.g = PairGeometry::make(pair_vector(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+    term.g = PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
     term.on = laws_.add_blocks(term.g, pr.history, dt_implicit, term.m, term.f, term.sliding);
     if (!term.on) continue;
     term.image_j = Vec3::Zero();

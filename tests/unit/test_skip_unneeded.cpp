@@ -159,6 +159,8 @@ TEST(SkipUnneeded, UnrequestedObserversAreNotComposed) {
   EXPECT_EQ(make_observers(c, dir).size(), 2u);
   c.scene.type = "pressure_shear";
   c.analysis.diffusion = false;
+  EXPECT_EQ(make_observers(c, dir).size(), 3u);  // rheology, the pressure cell, its profiles
+  c.observables.profiles = false;
   EXPECT_EQ(make_observers(c, dir).size(), 2u);  // rheology and the pressure cell
 }
 

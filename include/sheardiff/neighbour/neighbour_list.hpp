@@ -18,6 +18,11 @@ struct Pair {
   PairHistory history;
 };
 
+// The vector from i to (the image of) j of a listed pair, at the current positions and offset.
+inline Vec2 pair_separation(const Particles& p, const Box& box, const Pair& pr) {
+  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
+}
+
 // Verlet list built with a nanoflann k-d tree over the particles and their periodic
 // (and Lees-Edwards shifted) images. Every pair within s (1 + h_max/2) + skin is listed;
 // the list stays valid until the non-affine motion plus the affine shear of a pair can
