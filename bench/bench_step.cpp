@@ -107,7 +107,7 @@ void assembly(benchmark::State& state) {
   const double dt = implicit_dt(sim);
   for (auto _ : state) {
     d.force_balance().assemble(d.particles(), d.box(), d.flow(), d.neighbours().pairs(), dt,
-                               d.wall_drive());
+                               d.wall_bodies());
     benchmark::ClobberMemory();
   }
   label(state, sim);
@@ -117,7 +117,7 @@ void assembly(benchmark::State& state) {
 const sheardiff::ResistanceSystem& assembled(Simulation& sim) {
   auto& d = sim.dynamics();
   d.force_balance().assemble(d.particles(), d.box(), d.flow(), d.neighbours().pairs(),
-                             implicit_dt(sim), d.wall_drive());
+                             implicit_dt(sim), d.wall_bodies());
   return d.force_balance().system();
 }
 

@@ -16,6 +16,7 @@
 #include <variant>
 
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/scene/registry.hpp"
 
 namespace sheardiff {
 
@@ -109,12 +110,14 @@ const std::vector<KeySpec>& schema() {
   using C = Config;
   static const std::vector<KeySpec> specs = [] {
     std::vector<KeySpec> s;
+    std::vector<std::string> scenes;
+    std::string scene_doc = "Scene: ";
+    for (const SceneKind& k : scene_registry()) {
+      scene_doc += (scenes.empty() ? "" : "; ") + std::string(k.doc);
+      scenes.push_back(k.name);
+    }
     s.push_back(choice(
-        "scene.type", {"simple_shear", "pressure_shear"},
-        "Scene: `simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear "
-        "rate; `pressure_shear` = plane shear between rough walls, the top wall floating under "
-        "the load P Lx lz (the packing dilates to phi(J)).",
-        [](const C& c) { return Value{c.scene.type}; },
+        "scene.type", scenes, scene_doc + ".", [](const C& c) { return Value{c.scene.type}; },
         [](C& c, const Value& v) { c.scene.type = std::get<std::string>(v); }));
     s.push_back(integer("particles.N", &C::particles, &C::ParticlesCfg::n, 2, 1e6, "",
                         "Number of mobile particles."));
@@ -176,6 +179,16 @@ const std::vector<KeySpec>& schema() {
         "large-large pairs at size_ratio 1.4).",
         [](const C& c) { return Value{c.contact.stiffness}; },
         [](C& c, const Value& v) { c.contact.stiffness = std::get<std::string>(v); }));
+    s.push_back(
+        real("repulsion.F0", &C::repulsion, &C::Repulsion::f0, 0.0, 1e4, false, "P d^2",
+             "Electrostatic double-layer repulsion F0 exp(-h / lambda) between the "
+             "surfaces (h the gap, along the line of centres; F0 when touching); 0 = off."));
+    s.push_back(real("repulsion.lambda", &C::repulsion, &C::Repulsion::lambda, 0.0, 0.5, true, "d",
+                     "Debye length lambda of the double-layer repulsion."));
+    s.push_back(real("repulsion.cutoff", &C::repulsion, &C::Repulsion::cutoff, 1.0, 20.0, false,
+                     "lambda",
+                     "Gap, in Debye lengths, beyond which the repulsion is cut "
+                     "(where it has fallen to exp(-cutoff) F0)."));
     s.push_back(choice(
         "integrator.type", {"implicit", "euler", "heun"},
         "Spring integration: `implicit` (linearly implicit springs, dt set by accuracy), "
@@ -252,6 +265,10 @@ const std::vector<KeySpec>& schema() {
                      "pressure_shear: slab next to each wall left out of the bulk phi."));
     s.push_back(real("observables.profile_bin", &C::observables, &C::Observables::profile_bin, 0.0,
                      100.0, true, "d", "Bin width of the phi, u_x and T profiles across the gap."));
+    s.push_back(boolean("observables.profiles", &C::observables, &C::Observables::profiles,
+                        "Profiles across the gap of a scene with walls, over the measured window: "
+                        "phi, u_x, T = <u'.u'> and the pair stresses sigma_xy and p per bin "
+                        "(summary.json: profile_*). Off = they cost nothing."));
     s.push_back(boolean("analysis.diffusion", &C::analysis, &C::Analysis::diffusion,
                         "Self-diffusion analysis over the measured window (steady state, or "
                         "after run.transient_strain): MSD, D, dv, VACF, Psi; writes "
@@ -566,10 +583,16 @@ Config load_config(const std::filesystem::path& file, const std::vector<std::str
   Config cfg = parse_config(text, file.string(), overrides);
   // An empty or truncated file would otherwise run the default scene: the scene is the one
   // key a config file must give.
-  if (!names_scene(text, overrides))
+  if (!names_scene(text, overrides)) {
+    const auto& scenes = scene_registry();
+    std::string others;
+    for (std::size_t k = 0; k + 1 < scenes.size(); ++k)
+      others += fmt::format("{}\"{}\"", others.empty() ? "" : ", ", scenes[k].name);
     fail(file.string(), "scene.type",
-         "missing: a config file must say which scene it runs, e.g. [scene] type = "
-         "\"pressure_shear\" (or \"simple_shear\")");
+         fmt::format("missing: a config file must say which scene it runs, e.g. [scene] type = "
+                     "\"{}\" (or {})",
+                     scenes.back().name, others));
+  }
   auto& init = cfg.particles.init_file;
   if (!init.empty() && std::filesystem::path(init).is_relative())
     init = (file.parent_path() / init).lexically_normal().string();

@@ -24,55 +24,26 @@
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/observe/stress.hpp"
+#include "sheardiff/run_parts.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {
 
-namespace {
-
-std::optional<Lubrication> lubrication_of(const Config& cfg) {
-  if (!cfg.lubrication.enabled) return std::nullopt;
-  return Lubrication{cfg.lubrication.delta, cfg.lubrication.h_max, cfg.lubrication.tangential};
-}
-
-FrictionalContact contact_of(const Config& cfg) {
-  const double kn = cfg.contact.ktilde;
-  return FrictionalContact{kn, cfg.contact.kt_ratio * kn, cfg.contact.mu,
-                           cfg.contact.stiffness == "mean_radius"};
-}
-
-}  // namespace
-
 double interaction_range_factor(const Config& cfg) {
-  return cfg.lubrication.enabled ? 1.0 + 0.5 * cfg.lubrication.h_max : 1.0;
+  return PairLaws::from(cfg).range_factor();
 }
 
 double explicit_stability_dt(const Config& cfg) {
-  // The fastest spring mode is the smallest pair (two small discs): its normal and slip
-  // modes relax at rate k / R with R the dashpot (lubrication at contact) plus the drag.
-  const double a = 0.5;
-  const double drag = 3.0 * kPi * 2.0 * a / 2.0;  // relative motion of two drag-bound discs
-  double rn = drag, rt = drag;
-  if (auto lub = lubrication_of(cfg)) {
-    const PairResistance r = lub->coefficients(a, a, 0.0);
-    rn += r.xa;
-    rt += r.ya;
-  }
-  const FrictionalContact c = contact_of(cfg);
-  double dt = 2.0 * rn / c.kn;
-  if (c.has_friction()) dt = std::min(dt, 2.0 * rt / c.kt);
-  return dt;
+  return PairLaws::from(cfg).explicit_stability_dt();
 }
 
 bool rotational_unknowns(const Config& cfg) {
-  if (cfg.solver.rotations == "always") return true;
-  // Rotation couples to translation only through friction and the tangential lubrication modes
-  // (which include the contact dashpots); without both, omega = omega_inf + T_ext / drag.
-  const bool tangential_lubrication = cfg.lubrication.enabled && cfg.lubrication.tangential;
-  return contact_of(cfg).has_friction() || tangential_lubrication;
+  // Without a law that couples rotation to translation, omega = omega_inf + T_ext / drag.
+  return cfg.solver.rotations == "always" || PairLaws::from(cfg).needs_rotations();
 }
 
 void validate_run_inputs(const Config& cfg, const std::string& origin) {
@@ -82,7 +53,8 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
       throw ConfigError(fmt::format(
           "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
           "eta/P of explicit springs (smallest pair, normal and slip modes, "
-          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use integrator.dt < "
+          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use "
+          "integrator.dt < "
           "{:.3g}, integrator.dt = 0 (adaptive), or "
           "integrator.type = \"implicit\"",
           origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
@@ -113,7 +85,7 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
   // of the largest pair lets a disc meet its own image (ignored, so its stress is lost) or a
   // pair meet twice (one contact history for two images).
   const double cutoff = 2.0 * amax * interaction_range_factor(cfg) + cfg.neighbour.skin;
-  const bool periodic_y = cfg.scene.type == "simple_shear";
+  const bool periodic_y = scene_kind(cfg.scene.type).periodic_y;
   const double edge = periodic_y ? std::min(lx, ly) : lx;
   if (!(edge > 2.0 * cutoff))
     throw ConfigError(fmt::format(
@@ -140,7 +112,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = interaction_range_factor(cfg);
-  ForceBalance fb(lubrication_of(cfg), contact_of(cfg), rotational_unknowns(cfg) ? 3 : 2,
+  ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
@@ -160,8 +132,9 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
                                                       const std::filesystem::path& out_dir) {
   std::vector<std::unique_ptr<Observer>> obs;
   obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  std::function<bool(const Dynamics&)> measuring;
-  if (cfg.scene.type == "pressure_shear") {
+  MeasuredWindow measuring;
+  // A scene measured from its steady state has the pressure cell's detector of it.
+  if (scene_kind(cfg.scene.type).measured_from_steady_state) {
     auto cell = std::make_unique<PressureCellObserver>(cfg);
     const PressureCellObserver* c = cell.get();
     measuring = [c](const Dynamics&) { return c->steady(); };
@@ -170,6 +143,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
     const double from = cfg.run.transient_strain;
     measuring = [from](const Dynamics& d) { return d.strain() > from; };
   }
+  if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
+    obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
   if (cfg.analysis.diffusion)
     obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / "analysis.h5", measuring));
   return obs;
@@ -200,15 +175,6 @@ struct StopSignals {
   }
 };
 
-// A reader's runtime_error on a checkpoint whose checksum held means another build's state
-// layout; on an unchecked (version 2) one, corruption. Either way it is not resumed.
-[[noreturn]] void unreadable_checkpoint(const std::filesystem::path& file, const char* what) {
-  throw CorruptCheckpoint(fmt::format(
-      "{} cannot be read: {}. It was neither resumed nor changed; keep a copy if you need it, "
-      "then start the run again with --overwrite",
-      file.string(), what));
-}
-
 // Whether DIR/config.toml holds this resolved configuration (compared through the parser, so
 // that keys added to the code since do not make it look foreign).
 bool same_config(const std::filesystem::path& file, const std::string& resolved) {
@@ -218,17 +184,6 @@ bool same_config(const std::filesystem::path& file, const std::string& resolved)
     return false;
   }
 }
-// The same for the resolved text a checkpoint holds: an older sheardiff wrote it with other
-// keys or other float digits (0.69999999999999996 for 0.7).
-bool same_config_text(const std::string& text, const std::string& resolved) {
-  if (text == resolved) return true;
-  try {
-    return to_toml(parse_config(text, "checkpoint.bin")) == resolved;
-  } catch (const ConfigError&) {
-    return false;
-  }
-}
-
 std::string refusal(const RunDirectory& dir) {
   const std::string d = dir.path().string();
   switch (dir.state()) {
@@ -276,25 +231,13 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   return run_to_directory(cfg, dir, resume ? RunMode::resume : RunMode::start, progress);
 }
 
-// A function-try-block: every failure of the run passes the handlers at the end.
-nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode, bool progress,
-                                double progress_seconds) try {
-  // From here SIGINT/SIGTERM only set a flag: a signal during the set-up (minutes for a large
-  // packing) stops the run at step 0 with a checkpoint instead of leaving a bare directory.
-  StopSignals signals;
-  // When the run started (a resumed run: its first start, kept in the checkpoint), as Unix
-  // seconds; -1: unknown (a checkpoint of a sheardiff before the start was kept).
-  std::int64_t started = std::chrono::duration_cast<std::chrono::seconds>(
-                             std::chrono::system_clock::now().time_since_epoch())
-                             .count();
-  Config cfg = given;
-  resolve_defaults(cfg);
-  const std::string resolved = to_toml(cfg);
-  const std::filesystem::path& out_dir = dir.path();
-  const std::string out = out_dir.string();
-  const auto checkpoint_file = dir.file("checkpoint.bin");
+namespace {
 
-  // What is there decides what may be done; nothing is changed before the decision.
+// What DIR holds decides what may be done (docs/stability.md, "Run directories"); nothing is
+// changed here. Returns whether the run continues from DIR's checkpoint; throws ConfigError for
+// a refused command.
+bool check_directory(RunDirectory& dir, RunMode mode, const std::string& resolved) {
+  const std::string out = dir.path().string();
   const RunState state = dir.state();
   if (mode == RunMode::start && state != RunState::empty) throw ConfigError(refusal(dir));
   if (mode == RunMode::resume) {
@@ -307,290 +250,52 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
           "{}/config.toml)",
           out, out));
   }
-  if (mode == RunMode::resume && state == RunState::finished) {
-    // A run killed between its summary and the removal of its checkpoint is finished: say so,
-    // and complete the removal.
-    dir.start_log("resume of a finished run: " + this_command_line());
-    std::error_code ec;
-    std::filesystem::remove(checkpoint_file, ec);
-    std::fprintf(stderr, "%s: the run has already finished (summary.json); nothing to resume\n",
-                 out.c_str());
-    std::ifstream in(dir.file("summary.json"));
-    nlohmann::json js;
-    try {
-      js = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-      throw IoError(fmt::format("cannot read {}: {}", dir.file("summary.json").string(), e.what()));
-    }
-    return js;
+  return mode == RunMode::resume && state == RunState::interrupted;
+}
+
+// --resume of a finished run: a run killed between its summary and the removal of its
+// checkpoint is finished; say so, complete the removal and return its summary.
+nlohmann::json finished_run_summary(RunDirectory& dir) {
+  dir.start_log("resume of a finished run: " + this_command_line());
+  std::error_code ec;
+  std::filesystem::remove(dir.file("checkpoint.bin"), ec);
+  std::fprintf(stderr, "%s: the run has already finished (summary.json); nothing to resume\n",
+               dir.path().c_str());
+  std::ifstream in(dir.file("summary.json"));
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError(fmt::format("cannot read {}: {}", dir.file("summary.json").string(), e.what()));
   }
-  const bool from_checkpoint = mode == RunMode::resume && state == RunState::interrupted;
-  CheckpointPayload checkpoint;
-  if (from_checkpoint) checkpoint = read_checkpoint_file(checkpoint_file);
+}
 
-  // The initial state is built before anything is written: a bad input file leaves no output.
-  Simulation sim(cfg);
-  Dynamics& d = sim.dynamics();
-  const Particles& p = d.particles();
-  // The residual is one sparse product per solve, small next to the factorisation.
-  d.force_balance().set_check_residual(true);
-  RunHealth health(cfg, d);
-  auto observers = make_observers(cfg, out_dir);
-
-  double next_frame = cfg.output.frame_strain;
-  double next_checkpoint = cfg.output.checkpoint_strain;
-  double elapsed_before = 0.0;
-  long frames = 0;
-  // The whole evolving state of the run, in one fixed order for saving and loading.
-  // with_counters: version 3 checkpoints also hold the solver's work counters, and after them
-  // the run's start time (absent from those of a sheardiff before it: then unknown).
-  const auto serialize = [&](Archive& a, bool with_counters) {
-    std::string config = resolved;
-    a.io(config);
-    if (!same_config_text(config, resolved))
-      throw ConfigError(fmt::format(
-          "--resume {}: the configuration differs from the one the checkpoint was written with "
-          "(see {}/config.toml)",
-          out_dir.string(), out_dir.string()));
-    d.serialize(a);
-    sim.serialize_integrator(a);
-    for (auto& o : observers) o->serialize(a);
-    health.serialize(a);
-    a.io(next_frame), a.io(next_checkpoint), a.io(elapsed_before), a.io(frames);
-    if (with_counters) {
-      d.force_balance().system().serialize_counters(a);
-      if (!a.loading() || !a.at_end())
-        a.io(started);
-      else
-        started = -1;
-    }
-  };
-  if (from_checkpoint) {
-    Archive a = Archive::reader(std::move(checkpoint.bytes));
-    try {
-      serialize(a, checkpoint.checksummed);
-    } catch (const ConfigError&) {
-      throw;
-    } catch (const std::exception& e) {
-      unreadable_checkpoint(checkpoint_file, e.what());
-    }
-    if (!a.at_end()) unreadable_checkpoint(checkpoint_file, "bytes are left after the state");
-  }
-
-  // Only now is the directory changed: a new run starts from nothing of an earlier one.
+// The directory is taken over: a new run starts from nothing of an earlier one.
+void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool checksummed,
+                     const std::string& resolved) {
   if (from_checkpoint)
     dir.remove_partial_files();
   else
     dir.remove_run_files(/*keep_log=*/mode == RunMode::resume);
   dir.start_log(this_command_line());
-  if (from_checkpoint && !checkpoint.checksummed)
+  if (from_checkpoint && !checksummed)
     std::fprintf(stderr,
                  "warning: %s has no checksum (written by an older sheardiff): resumed unchecked\n",
-                 checkpoint_file.c_str());
+                 dir.file("checkpoint.bin").c_str());
   if (mode == RunMode::resume && !from_checkpoint)
     std::fprintf(stderr,
                  "%s: no checkpoint was written before the run stopped: starting again "
                  "from strain 0\n",
-                 out.c_str());
+                 dir.path().c_str());
   if (!from_checkpoint) write_file_atomically(dir.file("config.toml"), resolved);
+}
 
-  std::vector<std::string> names, units;
-  for (const auto& o : observers) {
-    for (auto& n : o->frame_names()) names.push_back(n);
-    for (auto& u : o->frame_units()) units.push_back(u);
-  }
-  std::unique_ptr<H5mdWriter> writer;
-  if (cfg.output.trajectory) {
-    TrajectoryLayout layout;
-    layout.n_particles = p.size();
-    layout.species = p.species;
-    for (double a : p.radius) layout.diameter.push_back(2.0 * a);
-    for (Motion m : p.motion) layout.motion.push_back(static_cast<int>(m));
-    layout.lx = d.box().lx;
-    layout.ly = d.height();
-    layout.lees_edwards = d.box().lees_edwards;
-    layout.write_velocity = cfg.output.velocities;
-    layout.observables = names;
-    layout.observable_units = units;
-    layout.write_contacts = cfg.output.contacts;
-    layout.author = cfg.output.author;
-    layout.creator_version = SHEARDIFF_VERSION;
-    layout.config_toml = resolved;
-    const auto file = dir.file("trajectory.h5");
-    writer = from_checkpoint
-                 ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, frames))
-                 : std::make_unique<H5mdWriter>(file, layout);
-  }
-  const auto save_checkpoint = [&](double elapsed_now) {
-    if (writer) writer->flush();  // the trajectory holds every frame the checkpoint counts
-    Archive a = Archive::writer();
-    double total = elapsed_before + elapsed_now;
-    std::swap(total, elapsed_before);
-    serialize(a, true);
-    std::swap(total, elapsed_before);
-    // Whole or absent: a checkpoint is never half-written.
-    const std::vector<char> bytes = checkpoint_file_bytes(a.bytes());
-    write_file_atomically(checkpoint_file, bytes.data(), bytes.size());
-  };
-
-  // Progress: a live line redrawn on a terminal (not logged), and a timestamped line every
-  // progress_seconds on stderr off a terminal, or in run.log alone (a terminal, --quiet).
-  const bool tty = progress && dir.terminal();
-  const auto t0 = std::chrono::steady_clock::now();
-  const auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
-  auto last_print = t0, last_line = t0, last_flush = t0;
-  bool shown = false;  // a live line is on the terminal: end it before anything else
-  std::vector<double> values;
-  const auto finished = [&] {
-    for (const auto& o : observers)
-      if (o->done(d)) return true;
-    return d.strain() >= cfg.run.strain * (1.0 - 1e-12) ||
-           (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
-  };
-  // A run gone wrong stops with a checkpoint if its state is finite (else the last one is
-  // kept) and a diagnostic frame.
-  const auto stop = [&](const HealthReport& r) {
-    if (r.state_finite) save_checkpoint(seconds());
-    write_diagnostic(dir.file("diagnostic.txt"), d, sim.integrator().velocities(), r);
-    if (shown) std::fprintf(stderr, "\n");
-    throw RunUnhealthy(r);
-  };
-  while (!finished()) {
-    if (const int sig = g_stop_signal.load()) {
-      save_checkpoint(seconds());
-      if (shown) std::fprintf(stderr, "\n");
-      throw RunInterrupted(
-          sig,
-          fmt::format(
-              "stopped by signal {} at step {} (strain {:.6g}); checkpoint written: resume with "
-              "`sheardiff run CONFIG --resume {}`",
-              sig, d.steps(), d.strain(), out_dir.string()));
-    }
-    if (!sim.try_step()) stop(health.solver_failure(d, sim.integrator().velocities()));
-    if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
-      stop(*r);
-    const StressSample s = sim.sample();
-    const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
-    for (const auto& o : observers) o->on_step(view);
-    if (d.strain() >= next_frame * (1.0 - 1e-12)) {
-      next_frame = next_output_strain(next_frame, cfg.output.frame_strain, d.strain());
-      values.clear();
-      for (const auto& o : observers) o->on_frame(view, values);
-      if (writer) {
-        FrameData f;
-        f.step = d.steps();
-        f.time = d.time();
-        f.lx = d.box().lx;
-        f.ly = d.height();
-        f.tilt = d.box().le_offset;
-        f.position = &p.position;
-        f.unwrapped = &p.unwrapped;
-        f.velocity = &sim.integrator().velocities().u;
-        f.observables = values;
-        ContactNetwork contacts;
-        if (cfg.output.contacts) contacts = contact_network(d);
-        f.contacts = &contacts;
-        writer->write_frame(f);
-      }
-      ++frames;
-      if (cfg.output.checkpoint_strain > 0.0 && d.strain() >= next_checkpoint * (1.0 - 1e-12)) {
-        next_checkpoint =
-            next_output_strain(next_checkpoint, cfg.output.checkpoint_strain, d.strain());
-        save_checkpoint(seconds());
-      }
-    }
-    const auto now = std::chrono::steady_clock::now();
-    // The trajectory is flushed every half minute so that a killed run leaves readable frames.
-    const bool live = tty && now - last_print > std::chrono::milliseconds(500);
-    const bool line = std::chrono::duration<double>(now - last_line).count() > progress_seconds;
-    if (live || line) {
-      const double el = std::chrono::duration<double>(now - t0).count();
-      // A pressure cell that has found its steady state stops at steady + measure_strain.
-      double end = cfg.run.strain;
-      for (const auto& o : observers) end = std::min(end, o->planned_end_strain());
-      const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
-      const std::string text =
-          fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
-                      d.steps(), static_cast<double>(d.steps()) / el, duration_text(eta));
-      if (live) {
-        std::fprintf(stderr, "\r%s   ", text.c_str());
-        last_print = now;
-        shown = true;
-      }
-      if (line) {
-        const std::string stamped = fmt::format("{}  {}\n", iso8601_utc_now(), text);
-        if (progress && !tty)
-          std::fputs(stamped.c_str(), stderr);
-        else
-          dir.log_only(stamped);
-        last_line = now;
-      }
-    }
-    if (writer && now - last_flush > std::chrono::seconds(30)) {
-      writer->flush();
-      last_flush = now;
-    }
-  }
-  // The last move may have used up the skin: check it against a fresh neighbour list.
-  if (d.neighbours().needs_rebuild()) {
-    d.rebuild_now();
-    if (auto r = health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
-      stop(*r);
-  }
-  if (shown) std::fprintf(stderr, "\n");
-  const double wall = elapsed_before + seconds();
-
-  // The end of the run. Every write below replaces what an earlier attempt may have written
-  // (tables, analysis.h5, summary.json), so a death anywhere in it resumes from the last
-  // checkpoint and completes; summary.json, written last, marks the run finished.
-  nlohmann::json js;
-  js["version"] = version();
-  js["git_hash"] = git_hash();
-  js["host"] = host_name();
-  js["seed"] = cfg.run.seed;
-  if (started >= 0)
-    js["started"] =
-        iso8601_utc(std::chrono::system_clock::time_point(std::chrono::seconds(started)));
-  else
-    js["started"] = nullptr;
-  js["finished"] = iso8601_utc_now();
-  js["scene"] = cfg.scene.type;
-  js["N"] = cfg.particles.n;
-  js["J"] = cfg.flow.j;
-  js["ktilde"] = cfg.contact.ktilde;
-  js["integrator"] = to_string(cfg.integrator.type);
-  js["strain"] = d.strain();
-  js["steps"] = d.steps();
-  js["steps_per_strain"] = d.steps() / std::max(d.strain(), 1e-300);
-  js["wall_seconds"] = wall;
-  js["ms_per_step"] = 1e3 * wall / static_cast<double>(std::max<long>(d.steps(), 1));
-  js["neighbour_rebuilds"] = d.neighbours().rebuilds();
-  js["factorisations"] = d.force_balance().system().factorisations();
-  {
-    // Which limit set the steps: where the step count comes from.
-    nlohmann::json by;
-    const auto& counts = d.step_limit_counts();
-    for (int k = 0; k < static_cast<int>(StepLimit::Count); ++k)
-      if (counts[k] > 0)
-        by[to_string(static_cast<StepLimit>(k))] =
-            static_cast<double>(counts[k]) / static_cast<double>(std::max<long>(d.steps(), 1));
-    js["dt_limited_by"] = by;
-  }
-  js["lx"] = d.box().lx;
-  js["ly"] = d.height();
-  dir.with_hdf5_reasons([&] {
-    for (const auto& o : observers) o->finish(d, js, writer.get());
-  });
-  health.report(js);
-  if (!js.contains("phi")) {
-    double area = 0;
-    for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
-    js["phi"] = area / (d.box().lx * d.height());
-  }
-  if (writer) writer->flush();
-  writer.reset();
+// The end of the run. Every write replaces what an earlier attempt may have written (tables,
+// analysis.h5, summary.json), so a death anywhere in it resumes from the last checkpoint and
+// completes; summary.json, written last, marks the run finished.
+nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seconds,
+                          RunDirectory& dir, TrajectoryOutput& trajectory) {
+  nlohmann::json js = run_summary(cfg, run, wall_seconds, dir, trajectory);
+  trajectory.close();
   // analysis.h5 is written by code that does not check its file's close: a full disk there
   // leaves a truncated file under the final name, which HDF5 then refuses to open.
   const auto analysis = dir.file("analysis.h5");
@@ -602,8 +307,92 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   }
   write_file_atomically(dir.file("summary.json"), json_text(js) + "\n");
   // Finished: the summary marks the run complete and the checkpoint has served its purpose.
-  std::filesystem::remove(checkpoint_file);
+  std::filesystem::remove(dir.file("checkpoint.bin"));
   return js;
+}
+
+std::int64_t unix_seconds_now() {
+  return std::chrono::duration_cast<std::chrono::seconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+// A function-try-block: every failure of the run passes the handlers at the end.
+nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode, bool progress,
+                                double progress_seconds) try {
+  // From here SIGINT/SIGTERM only set a flag: a signal during the set-up (minutes for a large
+  // packing) stops the run at step 0 with a checkpoint instead of leaving a bare directory.
+  StopSignals signals;
+  const std::int64_t started = unix_seconds_now();
+  Config cfg = given;
+  resolve_defaults(cfg);
+  const std::string resolved = to_toml(cfg);
+  const bool from_checkpoint = check_directory(dir, mode, resolved);
+  if (mode == RunMode::resume && dir.state() == RunState::finished)
+    return finished_run_summary(dir);
+  const CheckpointStore checkpoints(dir.file("checkpoint.bin"), resolved, dir.path().string());
+  CheckpointPayload payload;
+  if (from_checkpoint) payload = read_checkpoint_file(checkpoints.file());
+  // The initial state is built (and the checkpoint read) before anything is written: a bad
+  // input file leaves no output.
+  const bool checksummed = payload.checksummed;
+  RunningState run(cfg, dir.path(), started);
+  if (from_checkpoint) checkpoints.load(run, std::move(payload));
+  claim_directory(dir, mode, from_checkpoint, checksummed, resolved);
+  TrajectoryOutput trajectory(cfg, run, dir, resolved, from_checkpoint);
+  RunProgress progress_lines(dir, progress, progress_seconds);
+
+  Simulation& sim = run.sim;
+  Dynamics& d = sim.dynamics();
+  // A run gone wrong stops with a checkpoint if its state is finite (else the last one is
+  // kept) and a diagnostic frame.
+  const auto stop = [&](const HealthReport& r) {
+    if (r.state_finite) checkpoints.save(run, progress_lines.elapsed(), trajectory);
+    write_diagnostic(dir.file("diagnostic.txt"), d, sim.integrator().velocities(), r);
+    progress_lines.end_line();
+    throw RunUnhealthy(r);
+  };
+  std::vector<double> values;
+  while (!run.finished(cfg)) {
+    if (const int sig = g_stop_signal.load()) {
+      checkpoints.save(run, progress_lines.elapsed(), trajectory);
+      progress_lines.end_line();
+      throw RunInterrupted(sig, fmt::format("stopped by signal {} at step {} (strain {:.6g}); "
+                                            "checkpoint written: resume with `sheardiff run "
+                                            "CONFIG --resume {}`",
+                                            sig, d.steps(), d.strain(), dir.path().string()));
+    }
+    if (!sim.try_step()) stop(run.health.solver_failure(d, sim.integrator().velocities()));
+    if (auto r = run.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+      stop(*r);
+    const StressSample s = sim.sample();
+    const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
+    for (const auto& o : run.observers) o->on_step(view);
+    if (d.strain() >= run.next_frame * (1.0 - 1e-12)) {
+      run.next_frame = next_output_strain(run.next_frame, cfg.output.frame_strain, d.strain());
+      values.clear();
+      for (const auto& o : run.observers) o->on_frame(view, values);
+      trajectory.write_frame(cfg, run, values);
+      ++run.frames;
+      if (cfg.output.checkpoint_strain > 0.0 && d.strain() >= run.next_checkpoint * (1.0 - 1e-12)) {
+        run.next_checkpoint =
+            next_output_strain(run.next_checkpoint, cfg.output.checkpoint_strain, d.strain());
+        checkpoints.save(run, progress_lines.elapsed(), trajectory);
+      }
+    }
+    progress_lines.update(cfg, run);
+    trajectory.flush_now_and_then();
+  }
+  // The last move may have used up the skin: check it against a fresh neighbour list.
+  if (d.neighbours().needs_rebuild()) {
+    d.rebuild_now();
+    if (auto r = run.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+      stop(*r);
+  }
+  progress_lines.end_line();
+  return finish_run(cfg, run, run.elapsed_before + progress_lines.elapsed(), dir, trajectory);
 } catch (const IoError& e) {
   // Once the run has taken charge of the directory (its log started), a failure leaves it
   // resumable: the last checkpoint whole (it is never half-written), no FILE.tmp, and the user

@@ -7,7 +7,7 @@ gsd package and HOOMD itself read (docs/trajectory.md, "GSD export").
 Per frame: a 2D box (dimensions 2, Lz = 0) with the Lees-Edwards shift as the tilt factor
 xy = tilt / Ly, positions wrapped into HOOMD's centred box with matching `image` counts (the
 unwrapped position is position + image . box vectors, shifted by the constant (-Lx/2, -Ly/2)),
-diameters, velocities, and types small / large / fixed_wall / floating_wall. The pressure cell
+diameters, velocities, and types small / large / fixed_wall / floating_wall / driven_wall. The pressure cell
 has no periodicity in y: its GSD box (periodic in every direction in HOOMD) is made taller
 than the packing by two diameters, so that no contact crosses it. Scalar observables go to
 the frame log as sheardiff/<name>. Units stay the project's (docs/units.md): GSD has none.
@@ -18,7 +18,7 @@ import sys
 
 import numpy as np
 
-TYPES = ["small", "large", "fixed_wall", "floating_wall"]
+TYPES = ["small", "large", "fixed_wall", "floating_wall", "driven_wall"]
 
 
 def open_gsd(path):

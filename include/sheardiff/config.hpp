@@ -13,9 +13,12 @@ namespace sheardiff {
 enum class IntegratorType { Implicit, Euler, Heun };
 enum class MixRule { Area, Volume, Number };
 
+// The first scene of the registry (src/scene/registry.cpp), the default scene.type.
+std::string default_scene_name();
+
 struct Config {
   struct Scene {
-    std::string type = "simple_shear";
+    std::string type = default_scene_name();
   } scene;
   struct ParticlesCfg {
     std::int64_t n = 500;
@@ -42,6 +45,11 @@ struct Config {
     double mu = 0.5;
     std::string stiffness = "uniform";  // or "mean_radius" (kn, kt x (a_i + a_j) / d)
   } contact;
+  struct Repulsion {
+    double f0 = 0.0;       // P d^2; 0 = off
+    double lambda = 0.02;  // Debye length, d
+    double cutoff = 10.0;  // in Debye lengths
+  } repulsion;
   struct Integrator {
     IntegratorType type = IntegratorType::Implicit;
     double dt = 0.0;  // 0 = adaptive
@@ -77,6 +85,7 @@ struct Config {
   struct Observables {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi
     double profile_bin = 0.5;     // d, bin width of the profiles across the gap
+    bool profiles = true;         // profiles across the gap (scenes with walls)
   } observables;
   struct Analysis {
     bool diffusion = true;        // MSD, VACF, dv, Psi, D over the measured window

@@ -1,9 +1,9 @@
-// Command line of sheardiff: run a config, validate one, or print the config reference.
+// Command line of sheardiff: run a config, validate one, analyse a run, run a sweep, or print
+// the config reference. What a finished run or analysis prints is in result_text.cpp.
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -11,6 +11,7 @@
 #include <optional>
 #include <system_error>
 
+#include "result_text.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
@@ -102,46 +103,25 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
   return 0;
 }
 
-// A summary value, NaN when absent or not a number: summaries of older versions or of runs
-// that ended early lack some keys, and printing must not abort on them.
-double num(const nlohmann::json& js, const char* key) {
-  const auto it = js.find(key);
-  return it != js.end() && it->is_number() ? it->get<double>() : NAN;
-}
-double num_at(const nlohmann::json& js, const char* key, std::size_t i) {
-  const auto it = js.find(key);
-  return it != js.end() && it->is_array() && i < it->size() && (*it)[i].is_number()
-             ? (*it)[i].get<double>()
-             : NAN;
-}
-void print_warnings(const nlohmann::json& js) {
-  const auto it = js.find("analysis_warnings");
-  if (it == js.end() || !it->is_array()) return;
-  for (const auto& w : *it)
-    if (w.is_string()) fmt::print(stderr, "warning: {}\n", w.get<std::string>());
-}
-}  // namespace
-
-int main(int argc, char** argv) {
-  // CHOLMOD (Debian's build) opens OpenMP regions with a fixed num_threads clause inside its
-  // supernodal factorisation; only OMP_THREAD_LIMIT, read when libgomp loads, caps them. Spare
-  // threads spin and cost a shared 2-core machine ~40%, and sweeps already run one process per
-  // core, so sheardiff runs single-threaded unless the caller sets OMP_THREAD_LIMIT itself
-  // (docs/performance.md). Setting it needs a fresh process image: re-execute once.
-  if (std::getenv("OMP_THREAD_LIMIT") == nullptr) {
-    setenv("OMP_THREAD_LIMIT", "1", 1);
-    execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
-  }
-  sheardiff::quiet_hdf5_for_process();
+// Every subcommand and option of the command line.
+struct CommandLine {
+  CommandLine();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
+  CLI::App *run, *check, *doc, *analyse, *sweep;
+  std::string config_path, out_dir = "out", resume_dir, run_dir, sweep_file, backend;
+  std::vector<std::string> overrides;
+  bool overwrite = false, quiet = false, markdown = false, collect_only = false;
+  double progress_seconds = 60.0;
+  int jobs = 0;
+  long point = -1;
+};
+
+CommandLine::CommandLine() {
   app.require_subcommand(1);
   app.set_version_flag("--version", sheardiff::version_line(),
                        "Print the version and git commit, and exit");
 
-  std::string config_path, out_dir = "out";
-  std::vector<std::string> overrides;
-
-  auto* run = app.add_subcommand("run", "Run a configuration to its end");
+  run = app.add_subcommand("run", "Run a configuration to its end");
   run->add_option("config", config_path, "Configuration file (TOML, see docs/config.md)")
       ->required();
   auto* out_opt =
@@ -151,54 +131,44 @@ int main(int argc, char** argv) {
           ->capture_default_str();
   run->add_option("--set", overrides,
                   "Override one key, section.key=value (repeatable), e.g. --set flow.J=1e-3");
-  std::string resume_dir;
   auto* resume_opt = run->add_option(
       "--resume", resume_dir,
       "Continue the run in DIR from its checkpoint.bin (same CONFIG and --set); the "
       "trajectory is cut back to the checkpoint, the result is bit-identical to an "
       "uninterrupted run. A run stopped before its first checkpoint starts again; a finished "
       "one is left as it is");
-  bool overwrite = false;
   auto* overwrite_opt = run->add_flag(
       "--overwrite", overwrite,
       "Run in --out DIR even if it holds a run: every file of that run is deleted first");
   resume_opt->excludes(out_opt);
   resume_opt->excludes(overwrite_opt);
-  bool quiet = false;
   run->add_flag("-q,--quiet", quiet,
                 "No progress line; errors, warnings and the result's first line are still "
                 "printed, and DIR/run.log still gets everything");
-  double progress_seconds = 60.0;
   run->add_option("--progress-every", progress_seconds,
                   "Seconds between the timestamped progress lines written off a terminal and "
                   "to DIR/run.log")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
 
-  auto* check = app.add_subcommand("check", "Validate a configuration and print it resolved");
+  check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
   check->add_option("--set", overrides, "Override one key, section.key=value (repeatable)");
 
-  auto* doc = app.add_subcommand(
+  doc = app.add_subcommand(
       "config-doc",
       "Print every config key with its meaning, type, range, unit and default, as a commented "
       "TOML file of the defaults (lines of at most 100 columns)");
-  bool markdown = false;
   doc->add_flag("--markdown", markdown,
                 "Print the Markdown table instead (the one docs/config.md is made from)");
 
-  std::string run_dir;
-  auto* analyse = app.add_subcommand(
+  analyse = app.add_subcommand(
       "analyse",
       "Recompute the diffusion analysis (MSD, D, dv, VACF, Psi) of a finished run "
       "from DIR/trajectory.h5 alone; rewrites DIR/analysis.h5 and summary.json");
   analyse->add_option("dir", run_dir, "Run directory")->required();
 
-  std::string sweep_file, backend;
-  int jobs = 0;
-  long point = -1;
-  bool collect_only = false;
-  auto* sweep = app.add_subcommand(
+  sweep = app.add_subcommand(
       "sweep",
       "Run every point of a sweep file (axes over J, ktilde, N, seeds, ...) as its own "
       "run directory DIR/points/NAME, skipping finished points and resuming "
@@ -216,151 +186,100 @@ int main(int argc, char** argv) {
                   "fits.json (what the Slurm collect job does)");
   sweep->add_flag("-q,--quiet", quiet,
                   "No progress lines; failures and the result's first line are still printed");
+}
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help is a ParseError with exit code 0; every usage error is exit 2.
-    return app.exit(e) == 0 ? 0 : kExitConfig;
+// `sheardiff analyse DIR`: the diffusion analysis of a finished run, again.
+int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory>& dir) {
+  const std::string& run_dir = cl.run_dir;
+  dir.emplace(run_dir, false);
+  if (dir->state() != sheardiff::RunState::finished)
+    throw sheardiff::ConfigError(fmt::format(
+        "{}: analyse needs a finished run (summary.json); this directory holds {}", run_dir,
+        dir->state() == sheardiff::RunState::empty ? "no run" : "a run that has not finished"));
+  const auto run_cfg = sheardiff::load_config(dir->file("config.toml"));
+  {
+    // Read here so that a damaged summary is named (reanalyse_run would not name it).
+    std::ifstream in(dir->file("summary.json"));
+    try {
+      const auto summary = nlohmann::json::parse(in);
+      (void)summary;
+    } catch (const nlohmann::json::exception& e) {
+      throw sheardiff::ConfigError(
+          fmt::format("{}: not a valid summary: {}", dir->file("summary.json").string(), e.what()));
+    }
   }
+  if (!run_cfg.output.trajectory)
+    throw sheardiff::ConfigError(fmt::format(
+        "{}: the run was made with output.trajectory = false: there is no trajectory to "
+        "analyse",
+        run_dir));
+  dir->start_log(sheardiff::this_command_line());
+  dir->remove_partial_files();  // of an earlier analyse killed while writing
+  nlohmann::json js;
+  dir->with_hdf5_reasons([&] { js = sheardiff::reanalyse_run(run_dir); });
+  // Its writer does not check the file's close: a full disk leaves it truncated.
+  if (!sheardiff::hdf5_file_opens(dir->file("analysis.h5")))
+    throw sheardiff::IoError(fmt::format("cannot write {}: {}", dir->file("analysis.h5").string(),
+                                         dir->hdf5_log()->last_os_reason().empty()
+                                             ? "the file was left incomplete"
+                                             : dir->hdf5_log()->last_os_reason()));
+  fmt::print("{}", sheardiff::analysis_result_text(js, run_dir));
+  sheardiff::print_warnings(js);
+  return 0;
+}
 
-  // The run directory, locked, lives until main returns: what is printed below, error
-  // messages included, goes to its run.log too.
-  std::optional<sheardiff::RunDirectory> dir;
-  try {
-    if (doc->parsed()) {
-      std::cout << (markdown ? sheardiff::config_reference_markdown()
-                             : sheardiff::config_reference_text());
-      return 0;
-    }
-    if (analyse->parsed()) {
-      dir.emplace(run_dir, false);
-      if (dir->state() != sheardiff::RunState::finished)
-        throw sheardiff::ConfigError(fmt::format(
-            "{}: analyse needs a finished run (summary.json); this directory holds {}", run_dir,
-            dir->state() == sheardiff::RunState::empty ? "no run" : "a run that has not finished"));
-      const auto run_cfg = sheardiff::load_config(dir->file("config.toml"));
-      {
-        // Read here so that a damaged summary is named (reanalyse_run would not name it).
-        std::ifstream in(dir->file("summary.json"));
-        try {
-          const auto summary = nlohmann::json::parse(in);
-          (void)summary;
-        } catch (const nlohmann::json::exception& e) {
-          throw sheardiff::ConfigError(fmt::format("{}: not a valid summary: {}",
-                                                   dir->file("summary.json").string(), e.what()));
-        }
-      }
-      if (!run_cfg.output.trajectory)
-        throw sheardiff::ConfigError(fmt::format(
-            "{}: the run was made with output.trajectory = false: there is no trajectory to "
-            "analyse",
-            run_dir));
-      dir->start_log(sheardiff::this_command_line());
-      dir->remove_partial_files();  // of an earlier analyse killed while writing
-      nlohmann::json js;
-      dir->with_hdf5_reasons([&] { js = sheardiff::reanalyse_run(run_dir); });
-      // Its writer does not check the file's close: a full disk leaves it truncated.
-      if (!sheardiff::hdf5_file_opens(dir->file("analysis.h5")))
-        throw sheardiff::IoError(fmt::format(
-            "cannot write {}: {}", dir->file("analysis.h5").string(),
-            dir->hdf5_log()->last_os_reason().empty() ? "the file was left incomplete"
-                                                      : dir->hdf5_log()->last_os_reason()));
-      fmt::print(
-          "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
-          "(log-log slope {:.3f}); dv = {:.4g} +- {:.2g} gammadot d; Psi = {:.4g} +- {:.2g} / "
-          "gammadot; step length {:.4g} d\n",
-          run_dir, num(js, "D"), num(js, "D_err"), num_at(js, "msd_window", 0),
-          num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"),
-          num(js, "dv_err"), num(js, "psi"), num(js, "psi_err"), num(js, "step_length"));
-      print_warnings(js);
-      return 0;
-    }
-    if (sweep->parsed())
-      return run_sweep(sweep_file, out_dir, jobs, backend, point, collect_only, quiet);
-    if (check->parsed() && sheardiff::is_sweep_file(config_path)) {
-      // A sweep file: every point's config is built and validated (load_sweep), then listed.
-      if (!overrides.empty())
-        throw sheardiff::ConfigError(
-            "--set applies to run configs; a sweep sets keys in [sweep.set]");
-      const auto spec = sheardiff::load_sweep(config_path);
-      const auto points = sheardiff::expand_points(spec);
-      fmt::print("{}: a sweep of {} points over {}, every point's config valid:\n", config_path,
-                 points.size(), spec.base.string());
-      for (const auto& p : points) fmt::print("  {}\n", p.name);
-      return 0;
-    }
-    const sheardiff::Config cfg = sheardiff::load_config(config_path, overrides);
-    sheardiff::validate_run_inputs(cfg, config_path);
-    if (check->parsed()) {
-      std::cout << sheardiff::to_toml(cfg);
-      return 0;
-    }
-    const bool resume = !resume_dir.empty();
-    if (resume) out_dir = resume_dir;
-    using sheardiff::RunMode;
-    const RunMode mode = resume ? RunMode::resume : overwrite ? RunMode::overwrite : RunMode::start;
-    // --overwrite deletes DIR/config.toml: it must not be the file the user runs.
-    std::error_code same_ec;
-    if (mode == RunMode::overwrite &&
-        std::filesystem::equivalent(config_path, std::filesystem::path(out_dir) / "config.toml",
-                                    same_ec))
-      throw sheardiff::ConfigError(fmt::format(
-          "{} is the config.toml of the run in {}, which --overwrite deletes: copy it elsewhere "
-          "and run that copy",
-          config_path, out_dir));
-    dir.emplace(out_dir, mode != RunMode::resume);
-    const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, !quiet, progress_seconds);
-    const auto flag = [&](const char* key) {
-      const auto it = summary.find(key);
-      return it != summary.end() && it->is_boolean() && it->get<bool>();
-    };
-    const auto count = [&](const char* key) {
-      const auto it = summary.find(key);
-      return it != summary.end() && it->is_number() ? it->get<long>() : 0L;
-    };
-    fmt::print("{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n",
-               out_dir, num(summary, "strain"), count("steps"), num(summary, "wall_seconds"),
-               num(summary, "ms_per_step"), num(summary, "max_overlap"));
-    // The lines after the first: on the terminal unless --quiet, in run.log always.
-    std::string details;
-    if (summary.contains("steady")) {
-      if (!flag("steady")) {
-        details +=
-            fmt::format("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
-                        num(summary, "phi"));
-      } else {
-        details += fmt::format(
-            "  steady from strain {:.3g}: phi = {:.4f} +- {:.2g}, mu = {:.4f} +- {:.2g}, H = "
-            "{:.3f} d (+- statistical errors, time blocks)\n",
-            num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_err"),
-            num(summary, "mu"), num(summary, "mu_err"), num(summary, "H"));
-        details += fmt::format(
-            "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
-            "held steps)\n",
-            num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
-            count("steps") - count("wall_free_fall_steps"));
-      }
-    } else if (std::isnan(num(summary, "shear_stress"))) {
-      details += fmt::format("  no averages: the run ended before run.transient_strain\n");
-    } else {
-      details += fmt::format(
-          "  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
-          num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
-    }
-    if (summary.contains("D"))
-      details += fmt::format(
-          "  diffusion: D = {:.4g} +- {:.2g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
-          "+- {:.2g} gammadot d, Psi = {:.4g} +- {:.2g} / gammadot\n",
-          num(summary, "D"), num(summary, "D_err"), num_at(summary, "msd_window", 0),
-          num_at(summary, "msd_window", 1), num(summary, "dv"), num(summary, "dv_err"),
-          num(summary, "psi"), num(summary, "psi_err"));
-    if (quiet)
-      dir->log_only(details);
-    else
-      fmt::print("{}", details);
-    print_warnings(summary);
+// `sheardiff check SWEEP.toml`: every point's config is built and validated, then listed.
+int check_sweep_command(const CommandLine& cl) {
+  if (!cl.overrides.empty())
+    throw sheardiff::ConfigError("--set applies to run configs; a sweep sets keys in [sweep.set]");
+  const auto spec = sheardiff::load_sweep(cl.config_path);
+  const auto points = sheardiff::expand_points(spec);
+  fmt::print("{}: a sweep of {} points over {}, every point's config valid:\n", cl.config_path,
+             points.size(), spec.base.string());
+  for (const auto& p : points) fmt::print("  {}\n", p.name);
+  return 0;
+}
+
+// `sheardiff check CONFIG` and `sheardiff run CONFIG`.
+int config_command(CommandLine& cl, std::optional<sheardiff::RunDirectory>& dir) {
+  const sheardiff::Config cfg = sheardiff::load_config(cl.config_path, cl.overrides);
+  sheardiff::validate_run_inputs(cfg, cl.config_path);
+  if (cl.check->parsed()) {
+    std::cout << sheardiff::to_toml(cfg);
     return 0;
+  }
+  const bool resume = !cl.resume_dir.empty();
+  if (resume) cl.out_dir = cl.resume_dir;
+  using sheardiff::RunMode;
+  const RunMode mode = resume         ? RunMode::resume
+                       : cl.overwrite ? RunMode::overwrite
+                                      : RunMode::start;
+  // --overwrite deletes DIR/config.toml: it must not be the file the user runs.
+  std::error_code same_ec;
+  if (mode == RunMode::overwrite &&
+      std::filesystem::equivalent(cl.config_path, std::filesystem::path(cl.out_dir) / "config.toml",
+                                  same_ec))
+    throw sheardiff::ConfigError(fmt::format(
+        "{} is the config.toml of the run in {}, which --overwrite deletes: copy it elsewhere "
+        "and run that copy",
+        cl.config_path, cl.out_dir));
+  dir.emplace(cl.out_dir, mode != RunMode::resume);
+  const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, !cl.quiet, cl.progress_seconds);
+  fmt::print("{}", sheardiff::run_result_first_line(summary, cl.out_dir));
+  // The lines after the first: on the terminal unless --quiet, in run.log always.
+  const std::string details = sheardiff::run_result_details(summary);
+  if (cl.quiet)
+    dir->log_only(details);
+  else
+    fmt::print("{}", details);
+  sheardiff::print_warnings(summary);
+  return 0;
+}
+
+// The exit code of the exception being handled, its message printed.
+int exit_code_of_failure(const std::string& out_dir) {
+  try {
+    throw;
   } catch (const sheardiff::RunUnhealthy& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     fmt::print(stderr, "  diagnostic frame: {}/diagnostic.txt; checkpoint {}\n", out_dir,
@@ -386,5 +305,45 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitIo;
+  }
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  // CHOLMOD (Debian's build) opens OpenMP regions with a fixed num_threads clause inside its
+  // supernodal factorisation; only OMP_THREAD_LIMIT, read when libgomp loads, caps them. Spare
+  // threads spin and cost a shared 2-core machine ~40%, and sweeps already run one process per
+  // core, so sheardiff runs single-threaded unless the caller sets OMP_THREAD_LIMIT itself
+  // (docs/performance.md). Setting it needs a fresh process image: re-execute once.
+  if (std::getenv("OMP_THREAD_LIMIT") == nullptr) {
+    setenv("OMP_THREAD_LIMIT", "1", 1);
+    execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
+  }
+  sheardiff::quiet_hdf5_for_process();
+  CommandLine cl;
+  try {
+    cl.app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a ParseError with exit code 0; every usage error is exit 2.
+    return cl.app.exit(e) == 0 ? 0 : kExitConfig;
+  }
+  // The run directory, locked, lives until main returns: what is printed, error messages
+  // included, goes to its run.log too.
+  std::optional<sheardiff::RunDirectory> dir;
+  try {
+    if (cl.doc->parsed()) {
+      std::cout << (cl.markdown ? sheardiff::config_reference_markdown()
+                                : sheardiff::config_reference_text());
+      return 0;
+    }
+    if (cl.analyse->parsed()) return analyse_command(cl, dir);
+    if (cl.sweep->parsed())
+      return run_sweep(cl.sweep_file, cl.out_dir, cl.jobs, cl.backend, cl.point, cl.collect_only,
+                       cl.quiet);
+    if (cl.check->parsed() && sheardiff::is_sweep_file(cl.config_path))
+      return check_sweep_command(cl);
+    return config_command(cl, dir);
+  } catch (...) {
+    return exit_code_of_failure(cl.out_dir);
   }
 }

@@ -6,7 +6,7 @@
 
 namespace sheardiff {
 
-Dynamics::Dynamics(Particles particles, Box box, ShearFlow flow, ForceBalance force_balance,
+Dynamics::Dynamics(Particles particles, Box box, ImposedFlow flow, ForceBalance force_balance,
                    NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls)
     : particles_(std::move(particles)),
       box_(box),
@@ -15,10 +15,6 @@ Dynamics::Dynamics(Particles particles, Box box, ShearFlow flow, ForceBalance fo
       neighbours_(std::move(neighbours)),
       limits_(limits),
       walls_(std::move(walls)) {
-  if (walls_) {
-    drive_.load = walls_->load;
-    drive_.free_fall_cap = walls_->free_fall_cap;
-  }
   rebuild();
 }
 
@@ -40,52 +36,44 @@ void Dynamics::begin_step() {
     rebuild_due_ = false;
   }
   ForceBalance::update_contacts(particles_, box_, neighbours_.pairs());
-  if (walls_) drive_.vx = flow_.gammadot * height();
+  // A driven wall moves with the fluid at its height (the bottom wall is the flow's rest frame).
+  if (walls_ && walls_->top_role != WallRole::Fixed)
+    walls_->driven_vx = flow_.velocity(Vec2(0.0, mean_height(particles_, walls_->top))).x();
 }
 
 bool Dynamics::solve(double dt_implicit, Velocities& v) {
   return force_balance_.solve(particles_, box_, flow_, neighbours_.pairs(), dt_implicit,
-                              wall_drive(), v);
+                              wall_bodies(), v);
 }
 
 bool Dynamics::resolve_with_sticking(double dt_implicit, const std::vector<std::size_t>& switched,
                                      Velocities& v) {
   return force_balance_.resolve_with_sticking(particles_, box_, flow_, neighbours_.pairs(),
-                                              switched, dt_implicit, wall_drive(), v);
+                                              switched, dt_implicit, wall_bodies(), v);
 }
 
 int Dynamics::stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched) {
-  if (switched) switched->clear();
-  auto& pairs = neighbours_.pairs();
-  const auto& terms = force_balance_.terms();
-  int changed = 0;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    ContactHistory& c = pairs[k].contact;
-    if (!c.active || !c.sliding) continue;
-    const PairTerm& t = terms[k];
-    Vec6 u;
-    u << v.u[pairs[k].i], v.u[pairs[k].j] + t.image_j;
-    // Sliding means slipping in the direction of the stretch (xi grows past the cap); a slip
-    // against it unloads the spring, which then sticks (Coulomb: |f_t| < mu f_n).
-    if (FrictionalContact::slip_rate(t.g, u) * c.xi < 0.0) {
-      c.sliding = false;
-      ++changed;
-      if (switched) switched->push_back(k);
-    }
-  }
-  return changed;
+  return force_balance_.stick_reversed_sliding(particles_, neighbours_.pairs(), v.u, switched);
 }
 
 const char* to_string(StepLimit l) {
   switch (l) {
-    case StepLimit::Fixed: return "fixed";
-    case StepLimit::Strain: return "strain";
-    case StepLimit::Displacement: return "displacement";
-    case StepLimit::Gap: return "gap";
-    case StepLimit::Overlap: return "overlap";
-    case StepLimit::Explicit: return "explicit_stability";
-    case StepLimit::Growth: return "growth";
-    case StepLimit::Count: break;
+    case StepLimit::Fixed:
+      return "fixed";
+    case StepLimit::Strain:
+      return "strain";
+    case StepLimit::Displacement:
+      return "displacement";
+    case StepLimit::Gap:
+      return "gap";
+    case StepLimit::Overlap:
+      return "overlap";
+    case StepLimit::Explicit:
+      return "explicit_stability";
+    case StepLimit::Growth:
+      return "growth";
+    case StepLimit::Count:
+      break;
   }
   return "?";
 }
@@ -105,7 +93,8 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
     return fixed_step();
   }
   constexpr double kBig = std::numeric_limits<double>::infinity();
-  double dt = flow_.gammadot > 0.0 ? limits_.max_strain_step / flow_.gammadot : kBig;
+  const double clock_rate = flow_.clock_rate();
+  double dt = clock_rate > 0.0 ? limits_.max_strain_step / clock_rate : kBig;
   why = StepLimit::Strain;
   double vmax = 0.0;
   for (std::size_t i = 0; i < particles_.n_mobile; ++i) {
@@ -124,8 +113,9 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
     if (!t.on) continue;
     const Vec3 uj = v.u[pairs[k].j] + t.image_j;
     const double opening = t.g.n.dot(uj.head<2>() - v.u[pairs[k].i].head<2>());
-    if (pairs[k].contact.active) {
-      if (opening != 0.0) take(limits_.max_overlap_change / std::abs(opening), dt, StepLimit::Overlap);
+    if (pairs[k].history.touching) {
+      if (opening != 0.0)
+        take(limits_.max_overlap_change / std::abs(opening), dt, StepLimit::Overlap);
     } else if (opening < 0.0) {
       const double room = (t.g.r - t.g.s) + 0.5 * delta * t.g.s;
       take(limits_.max_gap_fraction * room / -opening, dt, StepLimit::Gap);
@@ -137,25 +127,10 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
 }
 
 void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
-  // Springs stretch with the slip at the geometry of the start of the step (recomputed here:
-  // after a Heun corrector the pair terms hold the predicted geometry) ...
-  const FrictionalContact& law = force_balance_.contact();
-  const bool friction = law.has_friction();
+  // The pair laws' histories (contact springs) advance at the geometry of the start of the
+  // step (recomputed: after a Heun corrector the pair terms hold the predicted geometry) ...
   auto& pairs = neighbours_.pairs();
-  const auto pair_geometry = [&](const Pair& pr) {
-    const Vec2 rij = particles_.position[pr.j] + box_.image_shift(pr.kx, pr.ky) -
-                     particles_.position[pr.i];
-    return PairGeometry::make(rij, particles_.radius[pr.i], particles_.radius[pr.j]);
-  };
-  if (friction) {
-    for (Pair& pr : pairs) {
-      if (!pr.contact.active) continue;
-      Vec6 u;
-      u << v.u[pr.i], v.u[pr.j];
-      if (particles_.motion[pr.j] == Motion::Mobile) u[3] += box_.image_velocity_x(pr.ky);
-      pr.contact.xi += FrictionalContact::slip_rate(pair_geometry(pr), u) * dt;
-    }
-  }
+  force_balance_.advance_histories(particles_, box_, flow_, pairs, v.u, dt);
   na_.resize(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     const Vec2 step = v.u[i].head<2>() * dt;
@@ -168,15 +143,11 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
     particles_.unwrapped[i] += step;
     particles_.velocity[i] = v.u[i];
   }
-  if (box_.lees_edwards) box_.le_offset += flow_.gammadot * box_.ly * dt;
-  // ... and are capped by Coulomb at the end of the step, where their force is next evaluated,
-  // so kt |xi| <= mu kn overlap holds at every force evaluation.
-  if (friction) {
-    for (Pair& pr : pairs)
-      if (pr.contact.active) pr.contact.sliding = law.apply_coulomb(pair_geometry(pr), pr.contact.xi);
-  }
+  if (box_.lees_edwards) box_.le_offset += flow_.image_velocity_x(1, box_.ly) * dt;
+  // ... and are capped at its end, where their forces are next evaluated.
+  force_balance_.cap_histories(particles_, box_, pairs);
   time_ += dt;
-  neighbours_.advance(na_, flow_.gammadot * dt);
+  neighbours_.advance(na_, flow_.clock_rate() * dt);
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 
@@ -190,7 +161,15 @@ void Dynamics::serialize(Archive& a) {
   a.io(steps_);
   a.io(rebuild_due_);
   a.io(limit_counts_);
-  a.io(drive_);
+  // The driven wall's state, in the layout of earlier checkpoints (vx, load, free-fall cap).
+  double wall_state[3] = {0.0, 0.0, 1.0};
+  if (walls_) {
+    wall_state[0] = walls_->driven_vx;
+    wall_state[1] = walls_->load;
+    wall_state[2] = walls_->free_fall_cap;
+  }
+  a.io(wall_state);
+  if (a.loading() && walls_) walls_->driven_vx = wall_state[0];
   neighbours_.serialize(a);
   if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs());
 }
@@ -198,7 +177,7 @@ void Dynamics::serialize(Archive& a) {
 Dynamics::Saved Dynamics::save() const {
   Saved s{particles_.position, particles_.unwrapped, {}, box_, time_};
   s.contacts.reserve(neighbours_.pairs().size());
-  for (const Pair& pr : neighbours_.pairs()) s.contacts.push_back(pr.contact);
+  for (const Pair& pr : neighbours_.pairs()) s.contacts.push_back(pr.history);
   return s;
 }
 
@@ -208,7 +187,7 @@ void Dynamics::restore(const Saved& s) {
   box_ = s.box;
   time_ = s.time;
   auto& pairs = neighbours_.pairs();
-  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k].contact = s.contacts[k];
+  for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k].history = s.contacts[k];
   // The Verlet bookkeeping of the undone move stays counted: that only rebuilds earlier.
 }
 

@@ -700,7 +700,8 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     write_fixed_dataset(f, susp("species"), species.get(), species.get(), {n},
                         codes(layout.species).data(), kNumber, path);
     Handle motion =
-        enum_type({{"mobile", 0}, {"fixed_wall", 1}, {"floating_wall", 2}}, path, susp("motion"));
+        enum_type({{"mobile", 0}, {"fixed_wall", 1}, {"floating_wall", 2}, {"driven_wall", 3}},
+                  path, susp("motion"));
     write_fixed_dataset(f, susp("motion"), motion.get(), motion.get(), {n},
                         codes(layout.motion).data(), kNumber, path);
   }

@@ -83,10 +83,10 @@ void NeighbourList::rebuild(Particles& p, const Box& box) {
   Tree tree(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   tree.buildIndex();
 
-  std::unordered_map<std::uint64_t, ContactHistory> history;
+  std::unordered_map<std::uint64_t, PairHistory> history;
   history.reserve(pairs_.size());
   for (const Pair& pr : pairs_)
-    if (pr.contact.active) history.emplace(pair_key(pr.i, pr.j), pr.contact);
+    if (pr.history.touching) history.emplace(pair_key(pr.i, pr.j), pr.history);
 
   pairs_.clear();
   std::vector<std::pair<unsigned int, double>> hits;
@@ -111,14 +111,13 @@ void NeighbourList::rebuild(Particles& p, const Box& box) {
       pr.kx = cloud.kx[idx];
       pr.ky = cloud.ky[idx];
       if (auto it = history.find(pair_key(pr.i, pr.j)); it != history.end())
-        pr.contact = it->second;
+        pr.history = it->second;
       pairs_.push_back(pr);
     }
   }
   // A deterministic order makes runs reproducible and the sparsity pattern well ordered.
-  std::sort(pairs_.begin(), pairs_.end(), [](const Pair& x, const Pair& y) {
-    return x.i != y.i ? x.i < y.i : x.j < y.j;
-  });
+  std::sort(pairs_.begin(), pairs_.end(),
+            [](const Pair& x, const Pair& y) { return x.i != y.i ? x.i < y.i : x.j < y.j; });
   na_since_build_.assign(n, Vec2::Zero());
   strain_since_build_ = 0.0;
   ++rebuilds_;

@@ -8,8 +8,9 @@
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/text.hpp"
-#include "sheardiff/version.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/scene/scene.hpp"
+#include "sheardiff/version.hpp"
 
 namespace sheardiff {
 
@@ -87,7 +88,7 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
   }
   // The measured window: frames from the detection of steady state (pressure cell) or after
   // the transient (simple shear), the same test the observer applied while running.
-  const bool pressure = cfg.scene.type == "pressure_shear";
+  const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state;
   if (pressure && !js.value("steady", false))
     throw std::runtime_error(fmt::format("{}: the run never reached steady state", dir.string()));
   const double from = pressure ? js["steady_detected_at"].get<double>() : cfg.run.transient_strain;
@@ -128,7 +129,9 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
     long nb = 0, nt = 0;
     for (std::size_t i = 0; i < f.motion.size(); ++i) {
       if (f.motion[i] == static_cast<int>(Motion::FixedWall)) yb += f.position[i].y(), ++nb;
-      if (f.motion[i] == static_cast<int>(Motion::FloatingWall)) yt += f.position[i].y(), ++nt;
+      if (f.motion[i] == static_cast<int>(Motion::FloatingWall) ||
+          f.motion[i] == static_cast<int>(Motion::DrivenWall))
+        yt += f.position[i].y(), ++nt;
     }
     if (nb > 0 && nt > 0) {
       walls = true;

@@ -9,74 +9,6 @@
 
 namespace sheardiff {
 
-double disc_area_between(double yc, double a, double y1, double y2) {
-  // Area of the disc below height y: a^2 (pi/2 + u sqrt(1-u^2) + asin u), u = (y - yc)/a.
-  const auto below = [&](double y) {
-    const double u = std::clamp((y - yc) / a, -1.0, 1.0);
-    return a * a * (0.5 * kPi + u * std::sqrt(1.0 - u * u) + std::asin(u));
-  };
-  return y2 > y1 ? below(y2) - below(y1) : 0.0;
-}
-
-void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb, double height,
-                      double lx, double weight) {
-  lx_ = lx;
-  const std::size_t need = static_cast<std::size_t>(std::ceil((height + 2.0) / bin_));
-  if (w_.size() < need)
-    for (auto* vec : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_}) vec->resize(need, 0.0);
-  for (double& x : w_) x += weight;
-  const auto bins = static_cast<long>(w_.size());
-  for (std::size_t i = 0; i < p.n_mobile; ++i) {
-    const double y = p.position[i].y() - yb, a = p.radius[i];
-    const auto lo = static_cast<long>(std::floor((y - a) / bin_));
-    const auto hi = static_cast<long>(std::floor((y + a) / bin_));
-    for (long b = std::max(0L, lo); b <= hi && b < bins; ++b)
-      area_[b] += weight * disc_area_between(y, a, b * bin_, (b + 1) * bin_);
-    const long c = static_cast<long>(std::floor(y / bin_));
-    if (c < 0 || c >= bins) continue;
-    const Vec3& v = u[i];
-    n_[c] += weight;
-    ux_[c] += weight * v.x();
-    ux2_[c] += weight * v.x() * v.x();
-    uy2_[c] += weight * v.y() * v.y();
-  }
-}
-
-Eigen::MatrixXd GapProfiles::table() const {
-  const auto nb = static_cast<Eigen::Index>(w_.size());
-  Eigen::MatrixXd t(nb, 4);
-  for (Eigen::Index b = 0; b < nb; ++b) {
-    const double n = n_[b];
-    const double ux = n > 0 ? ux_[b] / n : 0.0;
-    t(b, 0) = (static_cast<double>(b) + 0.5) * bin_;
-    t(b, 1) = w_[b] > 0 ? area_[b] / (w_[b] * lx_ * bin_) : 0.0;
-    t(b, 2) = ux;
-    t(b, 3) = n > 0 ? ux2_[b] / n - ux * ux + uy2_[b] / n : 0.0;
-  }
-  return t;
-}
-
-void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
-                             double exclusion) const {
-  if (empty() || !(gammadot > 0.0)) return;
-  const Eigen::MatrixXd t = table();
-  std::vector<double> y, phi, ux, temp, yb, uxb;
-  for (Eigen::Index b = 0; b < t.rows(); ++b) {
-    y.push_back(t(b, 0));
-    phi.push_back(t(b, 1));
-    ux.push_back(t(b, 2) / gammadot);
-    temp.push_back(t(b, 3) / (gammadot * gammadot));
-    if (n_[b] > 0 && t(b, 0) >= exclusion && t(b, 0) <= height - exclusion)
-      yb.push_back(t(b, 0)), uxb.push_back(t(b, 2) / gammadot);
-  }
-  js["profile_y"] = y;
-  js["profile_phi"] = phi;
-  js["profile_u_x"] = ux;  // in gammadot d (the imposed flow is y)
-  js["profile_T"] = temp;  // in (gammadot d)^2
-  js["profile_bin"] = bin_;
-  if (yb.size() >= 3) js["bulk_shear_rate_ratio"] = fit_line(yb, uxb).slope;
-}
-
 void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
                        const std::vector<double>& h, const std::vector<double>& phi,
                        const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
@@ -102,8 +34,7 @@ PressureCellObserver::PressureCellObserver(const Config& cfg)
       pressure_(1.0),
       lz_(cfg.flow.lz),
       run_strain_(cfg.run.strain),
-      error_block_(cfg.analysis.error_block),
-      profiles_(cfg.observables.profile_bin) {}
+      error_block_(cfg.analysis.error_block) {}
 
 double PressureCellObserver::bulk_phi(const Dynamics& d, double exclusion) {
   const Particles& p = d.particles();
@@ -182,7 +113,6 @@ void PressureCellObserver::on_step(const StepView& v) {
   mu_top_ += w * (-v.stress.top_wall_fx / a / pressure_);
   mu_bottom_ += w * (v.stress.bottom_wall_fx / a / pressure_);
   p_meas_ += w * v.stress.top_wall_fy / a;
-  profiles_.add(d.particles(), v.velocities.u, d.flow().y0, d.height(), d.box().lx, w);
 }
 
 double PressureCellObserver::planned_end_strain() const {
@@ -223,10 +153,6 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["measured_strain"] = d.strain() - steady_at_;
   add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, d.strain(),
                     error_block_);
-  // Into summary.json (written whole or not at all), not into the trajectory: an HDF5 file
-  // killed while its metadata is being changed can be left unreadable, and the end of a run
-  // must be resumable at every instant (tests/cli/final_phase_kill.sh).
-  profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
   (void)writer;
 }
 

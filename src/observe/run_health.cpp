@@ -48,7 +48,7 @@ double RunHealth::max_overlap(const Dynamics& d, std::size_t* pair) {
   double worst = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
-    const Vec2 rij = p.position[pr.j] + d.box().image_shift(pr.kx, pr.ky) - p.position[pr.i];
+    const Vec2 rij = pair_separation(p, d.box(), pr);
     // Compared squared: a square root per pair only for the few pairs that overlap.
     const double s = p.radius[pr.i] + p.radius[pr.j];
     const double r2 = rij.squaredNorm();
@@ -170,11 +170,7 @@ std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities
                               "H = {:.4g} d (initially {:.4g} d)",
                               jump, h, h0_));
     // A mobile disc beyond a wall row went through it.
-    double top = 0.0, bottom = 0.0;
-    for (int t : d.walls()->top) top += p.position[t].y();
-    for (int b : d.walls()->bottom) bottom += p.position[b].y();
-    top /= static_cast<double>(d.walls()->top.size());
-    bottom /= static_cast<double>(d.walls()->bottom.size());
+    const double top = mean_height(p, d.walls()->top), bottom = mean_height(p, d.walls()->bottom);
     for (std::size_t i = 0; i < p.n_mobile; ++i) {
       const double y = p.position[i].y();
       if (y < bottom - 2.0 * p.radius[i] || y > top + 2.0 * p.radius[i])

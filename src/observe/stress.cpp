@@ -34,7 +34,7 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
     const Pair& pr = pairs[k];
     const Vec6 f = t.force(v.u[pr.i], v.u[pr.j]);
     const Vec2 fj = f.segment<2>(3);
-    const bool contact = pr.contact.active;
+    const bool contact = pr.history.touching;
     const double l = contact ? t.g.r : t.g.s;
     s.sxx -= l * t.g.n.x() * fj.x();
     s.syy -= l * t.g.n.y() * fj.y();
@@ -47,6 +47,7 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
     }
     switch (p.motion[pr.j]) {
       case Motion::FloatingWall:
+      case Motion::DrivenWall:
         s.top_wall_fx += fj.x();
         s.top_wall_fy += fj.y();
         break;
@@ -54,7 +55,8 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
         s.bottom_wall_fx += fj.x();
         s.bottom_wall_fy += fj.y();
         break;
-      case Motion::Mobile: break;
+      case Motion::Mobile:
+        break;
     }
   }
   const double area = d.box().lx * d.height() * lz;
@@ -70,14 +72,15 @@ ContactNetwork contact_network(const Dynamics& d) {
   const Particles& p = d.particles();
   const FrictionalContact& law = d.force_balance().contact();
   for (const Pair& pr : d.neighbours().pairs()) {
-    if (!pr.contact.active) continue;
+    if (!pr.history.touching) continue;
     // Geometry of now, not of the last solve: the frame shows the positions of now.
-    const Vec2 rij = p.position[pr.j] + d.box().image_shift(pr.kx, pr.ky) - p.position[pr.i];
-    const PairGeometry g = PairGeometry::make(rij, p.radius[pr.i], p.radius[pr.j]);
+    const PairGeometry g =
+        PairGeometry::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
     c.pairs.push_back({pr.i, pr.j});
     c.normal_force.push_back(law.kn_of(g) * std::max(g.overlap(), 0.0));
-    c.tangential_force.push_back(-law.kt_of(g) * pr.contact.xi);  // spring force on j along z x n
-    c.sliding.push_back(pr.contact.sliding ? 1 : 0);
+    c.tangential_force.push_back(-law.kt_of(g) *
+                                 pr.history.contact.xi);  // spring force on j along z x n
+    c.sliding.push_back(pr.history.contact.sliding ? 1 : 0);
   }
   return c;
 }

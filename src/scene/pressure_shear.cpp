@@ -1,3 +1,5 @@
+// Pressure-imposed plane shear: a monolayer between two rough walls of frozen particles, the
+// bottom wall fixed, the top wall driven with the flow and floating under the load P Lx lz.
 #include <algorithm>
 #include <random>
 
@@ -69,6 +71,7 @@ Scene build_pressure_shear(const Config& cfg) {
     sc.particles.species[i] = pk.species[i];
   }
   WallBodies walls;
+  walls.top_role = WallRole::Floating;
   std::size_t k = n;
   for (const auto* row : {&bottom, &top}) {
     const bool is_top = row == &top;
@@ -92,7 +95,6 @@ Scene build_pressure_shear(const Config& cfg) {
   sc.box.lx = lx;
   sc.box.ly = fill_top + 2.0 * amax;  // extent at the start; not periodic in y
   sc.box.lees_edwards = false;
-  sc.box.gammadot = cfg.flow.j;
   sc.flow.gammadot = cfg.flow.j;
   sc.flow.y0 = y_bottom;
   sc.walls = std::move(walls);

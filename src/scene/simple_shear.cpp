@@ -1,62 +1,9 @@
-#include <fmt/format.h>
-
-#include <cmath>
-#include <stdexcept>
-
-#include "sheardiff/io/h5md.hpp"
+// Simple shear (Lees-Edwards periodic cell at fixed area fraction and shear rate): the engine's
+// validation scene.
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
 namespace sheardiff {
-
-namespace {
-
-Packing packing_from_file(const Config& cfg) {
-  const std::filesystem::path file = cfg.particles.init_file;
-  Packing pk;
-  std::vector<double> diameter;
-  const auto ext = file.extension().string();
-  if (ext == ".h5" || ext == ".hdf5" || ext == ".h5md") {
-    H5mdFrame f = read_h5md_frame(file, cfg.particles.init_frame);
-    for (std::size_t k = 0; k < f.position.size(); ++k) {
-      if (!f.motion.empty() && f.motion[k] != 0) continue;  // mobile particles only
-      pk.position.push_back(f.position[k]);
-      diameter.push_back(f.diameter.empty() ? 1.0 : f.diameter[k]);
-    }
-    pk.lx = f.lx;
-    pk.ly = f.ly;
-    if (f.periodic_y) pk.tilt = f.tilt;
-  } else {
-    TableConfiguration t = read_position_table(file);
-    pk.position = t.position;
-    diameter = t.diameter;
-  }
-  double area = 0.0;
-  for (double d : diameter) {
-    pk.radius.push_back(0.5 * d);
-    pk.species.push_back(d > 1.0 + 1e-9 ? 1 : 0);
-    area += 0.25 * kPi * d * d;
-  }
-  if (pk.lx <= 0.0 || pk.ly <= 0.0) {
-    pk.lx = std::sqrt(area / cfg.particles.phi_init / cfg.particles.aspect);
-    pk.ly = cfg.particles.aspect * pk.lx;
-  }
-  if (static_cast<std::int64_t>(pk.position.size()) != cfg.particles.n)
-    throw ConfigError(fmt::format("particles.init_file: {} holds {} mobile particles but "
-                                  "particles.N = {}",
-                                  file.string(), pk.position.size(), cfg.particles.n));
-  return pk;
-}
-
-}  // namespace
-
-Packing initial_packing(const Config& cfg) {
-  return cfg.particles.init_file.empty()
-             ? random_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
-                              cfg.particles.phi_init, cfg.particles.aspect,
-                              static_cast<std::uint64_t>(cfg.run.seed))
-             : packing_from_file(cfg);
-}
 
 Scene build_simple_shear(const Config& cfg) {
   Packing pk = initial_packing(cfg);
@@ -71,16 +18,9 @@ Scene build_simple_shear(const Config& cfg) {
   sc.box.ly = pk.ly;
   sc.box.lees_edwards = true;
   sc.box.le_offset = pk.tilt;
-  sc.box.gammadot = cfg.flow.j;
   sc.flow.gammadot = cfg.flow.j;
   sc.flow.y0 = 0.0;
   return sc;
-}
-
-Scene build_scene(const Config& cfg) {
-  if (cfg.scene.type == "simple_shear") return build_simple_shear(cfg);
-  if (cfg.scene.type == "pressure_shear") return build_pressure_shear(cfg);
-  throw ConfigError(fmt::format("scene.type: unknown scene \"{}\"", cfg.scene.type));
 }
 
 }  // namespace sheardiff

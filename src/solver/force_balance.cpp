@@ -5,17 +5,16 @@
 namespace sheardiff {
 
 namespace {
-Vec2 pair_vector(const Particles& p, const Box& box, const Pair& pr) {
-  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
+PairGeometry pair_geometry(const Particles& p, const Box& box, const Pair& pr) {
+  return PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
 }
 }  // namespace
 
-ForceBalance::ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact,
-                           int dof, bool implicit_springs, const std::string& cholesky)
-    : lubrication_(lubrication),
-      contact_(contact),
+ForceBalance::ForceBalance(PairLaws laws, int dof, bool implicit_springs,
+                           const std::string& cholesky)
+    : laws_(std::move(laws)),
       system_(dof, cholesky),
-      diagonal_only_(!lubrication && !implicit_springs) {}
+      diagonal_only_(!laws_.resistive() && !implicit_springs) {}
 
 void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs) {
   terms_.assign(pairs.size(), PairTerm{});
@@ -24,85 +23,113 @@ void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs
 
 void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs) {
   for (Pair& pr : pairs) {
-    const double r = pair_vector(p, box, pr).norm();
+    const double r = pair_separation(p, box, pr).norm();
     const bool touching = r <= p.radius[pr.i] + p.radius[pr.j];
-    if (touching != pr.contact.active) pr.contact = ContactHistory{touching, 0.0, false};
+    if (touching != pr.history.touching) pr.history = PairHistory{touching, {}};
   }
 }
 
+void ForceBalance::advance_histories(const Particles& p, const Box& box, const ImposedFlow& flow,
+                                     std::vector<Pair>& pairs, const std::vector<Vec3>& u,
+                                     double dt) const {
+  if (!laws_.keeps_history()) return;
+  for (Pair& pr : pairs) {
+    if (!pr.history.touching) continue;
+    Vec6 up;
+    up << u[pr.i], u[pr.j];
+    if (p.motion[pr.j] == Motion::Mobile) up[3] += flow.image_velocity_x(pr.ky, box.ly);
+    laws_.advance(pr.history, pair_geometry(p, box, pr), up, dt);
+  }
+}
+
+void ForceBalance::cap_histories(const Particles& p, const Box& box,
+                                 std::vector<Pair>& pairs) const {
+  if (!laws_.keeps_history()) return;
+  for (Pair& pr : pairs)
+    if (pr.history.touching) laws_.cap(pr.history, pair_geometry(p, box, pr));
+}
+
+int ForceBalance::stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
+                                         const std::vector<Vec3>& u,
+                                         std::vector<std::size_t>* switched) const {
+  (void)p;
+  if (switched) switched->clear();
+  int changed = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    PairHistory& h = pairs[k].history;
+    if (!h.touching || !h.contact.sliding) continue;
+    const PairTerm& t = terms_[k];
+    Vec6 up;
+    up << u[pairs[k].i], u[pairs[k].j] + t.image_j;
+    if (FrictionalContact::stick_if_unloading(h.contact, t.g, up)) {
+      ++changed;
+      if (switched) switched->push_back(k);
+    }
+  }
+  return changed;
+}
+
 template <bool kWalls>
-void ForceBalance::assemble_pairs(const Particles& p, const Box& box,
+void ForceBalance::assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
                                   const std::vector<Pair>& pairs, double dt_implicit,
-                                  const WallDrive* wall) {
-  const bool friction = contact_.has_friction();
+                                  const WallBodies* walls) {
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
-    term.g = PairGeometry::make(pair_vector(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
-    const bool contact = pr.contact.active;
-    const bool lubricated = lubrication_ && lubrication_->acts(term.g.h);
-    term.on = contact || lubricated;
+    term.g = PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+    term.on = laws_.add_blocks(term.g, pr.history, dt_implicit, term.m, term.f, term.sliding);
     if (!term.on) continue;
-    term.m.setZero();
-    term.f.setZero();
-    if (lubricated || (contact && lubrication_))
-      term.m =
-          lubrication_->coefficients(term.g.ai, term.g.aj, term.g.h).matrix(term.g.n, term.g.t);
-    if (contact) {
-      term.f = contact_.spring_force(term.g, friction ? pr.contact.xi : 0.0);
-      // Sliding is what the last Coulomb cap decided, not a re-test of |xi| against the new
-      // overlap: a growing overlap would otherwise turn a sliding contact sticky.
-      term.sliding = friction && pr.contact.sliding;
-      if (dt_implicit > 0.0) term.m += dt_implicit * contact_.stiffness(term.g, term.sliding);
-    }
     term.image_j = Vec3::Zero();
     Vec3 known = Vec3::Zero();
     if constexpr (kWalls) {
       const Motion mj = p.motion[pr.j];
       if (mj == Motion::Mobile)
-        known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
-      else if (mj == Motion::FloatingWall)
-        known.x() = wall->vx;
+        known.x() = term.image_j.x() = flow.image_velocity_x(pr.ky, box.ly);
+      else if (mj == Motion::FloatingWall || mj == Motion::DrivenWall)
+        known.x() = walls->driven_vx;
       system_.add_pair(k, pr, term.m, term.f, known, mj == Motion::Mobile,
                        mj == Motion::FloatingWall);
     } else {
-      known.x() = term.image_j.x() = box.image_velocity_x(pr.ky);
+      known.x() = term.image_j.x() = flow.image_velocity_x(pr.ky, box.ly);
       system_.add_pair(k, pr, term.m, term.f, known, true, false);
     }
   }
 }
 
-bool ForceBalance::solve(const Particles& p, const Box& box, const ShearFlow& flow,
-                         const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
-                         Velocities& out) {
-  assemble(p, box, flow, pairs, dt_implicit, wall);
-  return solve_assembled(p, flow, wall, out);
+bool ForceBalance::solve(const Particles& p, const Box& box, const ImposedFlow& flow,
+                         const std::vector<Pair>& pairs, double dt_implicit,
+                         const WallBodies* walls, Velocities& out) {
+  assemble(p, box, flow, pairs, dt_implicit, walls);
+  return solve_assembled(p, flow, walls, out);
 }
 
-bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box, const ShearFlow& flow,
-                                         const std::vector<Pair>& pairs,
+bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
+                                         const ImposedFlow& flow, const std::vector<Pair>& pairs,
                                          const std::vector<std::size_t>& switched,
-                                         double dt_implicit, const WallDrive* wall,
+                                         double dt_implicit, const WallBodies* walls,
                                          Velocities& out) {
   // A fresh assembly reads the contacts' new state: taken when a contact with the floating wall
   // switched (its column is not a low-rank term), or when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
   bool full = !system_.low_rank_pays(switched.size());
   for (std::size_t k : switched) full = full || p.motion[pairs[k].j] == Motion::FloatingWall;
-  if (full) return solve(p, box, flow, pairs, dt_implicit, wall, out);
+  if (full) return solve(p, box, flow, pairs, dt_implicit, walls, out);
   const int d = system_.dof();
   VecX w, dg;
   for (std::size_t k : switched) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
-    const double kt = dt_implicit * contact_.kt_of(term.g);
+    const double kt = dt_implicit * contact().kt_of(term.g);
     const Vec6 w6 = FrictionalContact::slip_mode(term.g);
     // The pair term as a new assembly would make it (stresses read it after the step).
     term.m += kt * w6 * w6.transpose();
     term.sliding = false;
     const bool j_mobile = p.motion[pr.j] == Motion::Mobile;
-    // Known velocity of j's side: the Lees-Edwards image's, or zero for a fixed wall.
-    const double known_x = j_mobile ? term.image_j.x() : 0.0;
+    // Known velocity of j's side: the Lees-Edwards image's, a driven wall's, or zero for a
+    // fixed wall.
+    const double known_x = j_mobile                               ? term.image_j.x()
+                           : p.motion[pr.j] == Motion::DrivenWall ? walls->driven_vx
+                                                                  : 0.0;
     w.setZero(static_cast<Eigen::Index>(system_.unknowns()));
     dg.setZero(w.size());
     const double wj_known = w6[3] * known_x;
@@ -116,12 +143,12 @@ bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box, con
     }
     system_.add_low_rank(w, kt, dg);
   }
-  return solve_assembled(p, flow, wall, out);
+  return solve_assembled(p, flow, walls, out);
 }
 
-void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow& flow,
+void ForceBalance::assemble(const Particles& p, const Box& box, const ImposedFlow& flow,
                             const std::vector<Pair>& pairs, double dt_implicit,
-                            const WallDrive* wall) {
+                            const WallBodies* walls) {
   if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
   if (dt_implicit > 0.0 && diagonal_only_)
     throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
@@ -133,19 +160,19 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ShearFlow&
     system_.add_self(static_cast<int>(i), drag, force);
   }
   // Scenes without walls get a loop with no wall branch at all.
-  if (wall)
-    assemble_pairs<true>(p, box, pairs, dt_implicit, wall);
+  if (walls)
+    assemble_pairs<true>(p, box, flow, pairs, dt_implicit, walls);
   else
-    assemble_pairs<false>(p, box, pairs, dt_implicit, wall);
+    assemble_pairs<false>(p, box, flow, pairs, dt_implicit, walls);
 }
 
-bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
-                                   Velocities& out) {
+bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
+                                   const WallBodies* walls, Velocities& out) {
   double v = 0.0;
   bool capped = false;
-  const bool ok =
-      wall ? system_.solve_with_floating_wall(u_, wall->load, wall->free_fall_cap, v, capped)
-           : system_.solve(u_);
+  const bool ok = walls && walls->floating() ? system_.solve_with_floating_wall(
+                                                   u_, walls->load, walls->free_fall_cap, v, capped)
+                                             : system_.solve(u_);
   out.wall_free_fall = capped;
   if (!ok) return false;
   if (check_residual_) residual_ = system_.residual(u_, v);
@@ -169,7 +196,10 @@ bool ForceBalance::solve_assembled(const Particles& p, const ShearFlow& flow, co
         out.u[i].setZero();
         break;
       case Motion::FloatingWall:
-        out.u[i] = wall ? Vec3(wall->vx, v, 0.0) : Vec3::Zero();
+        out.u[i] = walls ? Vec3(walls->driven_vx, v, 0.0) : Vec3::Zero();
+        break;
+      case Motion::DrivenWall:
+        out.u[i] = walls ? Vec3(walls->driven_vx, 0.0, 0.0) : Vec3::Zero();
         break;
     }
   }

@@ -98,9 +98,9 @@ SweepSpec load_sweep(const fs::path& file) {
                     fs::is_directory(spec.base) ? "a directory" : "not a regular file"));
 
   if (const auto results = get_or<std::string>(*sweep, "results", "", w); !results.empty())
-    spec.results = (fs::path(results).is_absolute() ? fs::path(results)
-                                                    : spec.file.parent_path() / results)
-                       .lexically_normal();
+    spec.results =
+        (fs::path(results).is_absolute() ? fs::path(results) : spec.file.parent_path() / results)
+            .lexically_normal();
 
   spec.jobs = static_cast<int>(get_or<int64_t>(*sweep, "jobs", 2, w));
   if (spec.jobs < 1 || spec.jobs > 256)
@@ -228,9 +228,10 @@ std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
     } catch (const ConfigError&) {
       continue;  // load_sweep reports it, with the point's name
     }
-    const double strain = cfg.scene.type == "pressure_shear" && cfg.steady.measure_strain > 0
-                              ? cfg.steady.measure_strain + 3.0 * cfg.steady.window
-                              : cfg.run.strain;
+    const double strain =
+        scene_kind(cfg.scene.type).measured_from_steady_state && cfg.steady.measure_strain > 0
+            ? cfg.steady.measure_strain + 3.0 * cfg.steady.window
+            : cfg.run.strain;
     p.cost = static_cast<double>(cfg.particles.n) * std::max(strain, 1e-3) /
              std::sqrt(std::max(cfg.flow.j, 1e-8));
   }

@@ -16,7 +16,7 @@ import re, sys
 text = open(sys.argv[1], encoding="utf-8").read().splitlines()
 wide = [l for l in text if len(l) > 100]
 if wide: sys.exit(f"FAIL: {len(wide)} lines over 100 columns, e.g. {wide[0]!r}")
-keys = re.findall(r"^\| `([a-z_]+)\.([A-Za-z_]+)` \|", open(sys.argv[2]).read(), re.M)
+keys = re.findall(r"^\| `([a-z_]+)\.([A-Za-z0-9_]+)` \|", open(sys.argv[2]).read(), re.M)
 section, found = None, set()
 for l in text:
     m = re.match(r"^\[(\w+)\]$", l)

@@ -67,7 +67,7 @@ done
   for t in '[' ']' '=' '\"' '.' '\x0a' '\x00' true false nan inf -inf 1e-3 0 -1 1e18; do
     printf '"%s"\n' "$t"
   done
-  sed -n 's/^| `\([a-z_]*\)\.\([A-Za-z_]*\)` |.*/\1 \2/p' "$root/docs/config.md" |
+  sed -n 's/^| `\([a-z_]*\)\.\([A-Za-z0-9_]*\)` |.*/\1 \2/p' "$root/docs/config.md" |
     while read -r sec key; do
       printf '"[%s]"\n"%s"\n"%s = "\n"%s.%s="\n' "$sec" "$key" "$key" "$sec" "$key"
     done

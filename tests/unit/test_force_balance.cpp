@@ -30,7 +30,7 @@ Config dense_config(IntegratorType type) {
 
 std::size_t count_contacts(const Dynamics& d) {
   std::size_t n = 0;
-  for (const Pair& pr : d.neighbours().pairs()) n += pr.contact.active ? 1 : 0;
+  for (const Pair& pr : d.neighbours().pairs()) n += pr.history.touching ? 1 : 0;
   return n;
 }
 
@@ -127,8 +127,7 @@ TEST(PairAssembly, SwappingTheLabelsOfAPairGivesTheSameVelocities) {
   Box box;
   box.lx = box.ly = 20.0;
   box.lees_edwards = true;
-  box.gammadot = 0.1;
-  const ShearFlow flow{0.1, 0.0};
+  const ImposedFlow flow{0.1, 0.0};
   const auto solve = [&](bool swapped) {
     std::vector<Pair> pairs(2);
     pairs[0].i = swapped ? 1 : 0;
@@ -150,8 +149,8 @@ TEST(PairAssembly, SwappingTheLabelsOfAPairGivesTheSameVelocities) {
   for (int i = 0; i < 3; ++i)
     EXPECT_LE((a[i] - b[i]).cwiseAbs().maxCoeff(), 1e-12 * scale) << "particle " << i;
   // The coupling is real: without the pairs the velocities would be drag-only.
-  const Vec3 drag_only = flow.velocity(p.position[0]) +
-                         p.external[0].cwiseQuotient(StokesDrag::resistance(0.5));
+  const Vec3 drag_only =
+      flow.velocity(p.position[0]) + p.external[0].cwiseQuotient(StokesDrag::resistance(0.5));
   EXPECT_GT((a[0] - drag_only).cwiseAbs().maxCoeff(), 1e-3 * scale);
 }
 
@@ -166,8 +165,7 @@ Scene lone_particle_scene(double j, double y) {
   sc.particles.radius[0] = 0.5;
   sc.box.lx = sc.box.ly = 10.0;
   sc.box.lees_edwards = true;
-  sc.box.gammadot = j;
-  sc.flow = ShearFlow{j, 0.0};
+  sc.flow = ImposedFlow{j, 0.0};
   return sc;
 }
 
@@ -218,8 +216,7 @@ Scene dilute_scene(double j) {
                            Vec3(0.7, 0.0, 1.1)};
   sc.box.lx = sc.box.ly = 20.0;
   sc.box.lees_edwards = true;
-  sc.box.gammadot = j;
-  sc.flow = ShearFlow{j, 0.0};
+  sc.flow = ImposedFlow{j, 0.0};
   return sc;
 }
 
@@ -302,7 +299,7 @@ TEST(DragOnly, StokesDragCoefficients) {
   EXPECT_NEAR(StokesDrag::resistance(0.5).z(), kPi, 1e-14);
   EXPECT_NEAR(StokesDrag::resistance(0.7).y(), 4.2 * kPi, 1e-14);
   EXPECT_NEAR(StokesDrag::resistance(0.7).z(), 2.744 * kPi, 1e-14);
-  const ShearFlow flow{0.2, 1.5};
+  const ImposedFlow flow{0.2, 1.5};
   const Vec3 v = flow.velocity(Vec2(7.0, 4.0));
   EXPECT_NEAR(v.x(), 0.2 * 2.5, 1e-15);
   EXPECT_EQ(v.y(), 0.0);

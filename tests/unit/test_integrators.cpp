@@ -103,7 +103,7 @@ RunSummary run_steps(const Scene& scene, IntegratorType type, double ktilde, dou
 TEST(Integrators, ImplicitAndExplicitAgreeAsDtShrinks) {
   constexpr double kKtilde = 1e3;
   const Config base = dense_config(kKtilde, IntegratorType::Implicit, 0.0);
-  const Scene scene = build_simple_shear(base);
+  const Scene scene = build_scene(base);
   const double dt_stab = explicit_stability_dt(base);
   const double t_end = 0.02 / base.flow.j;
   const std::vector<double> dts = {0.02, 0.01, 0.005};
@@ -150,13 +150,15 @@ constexpr double kStiff = 1e5;
 constexpr int kStiffSteps = 300;
 
 const Scene& stiff_scene() {
-  static const Scene scene = build_simple_shear(dense_config(kStiff, IntegratorType::Implicit, 0.0));
+  static const Scene scene = build_scene(dense_config(kStiff, IntegratorType::Implicit, 0.0));
   return scene;
 }
-double stiff_dt() { return 20.0 * explicit_stability_dt(dense_config(kStiff, IntegratorType::Implicit, 0.0)); }
+double stiff_dt() {
+  return 20.0 * explicit_stability_dt(dense_config(kStiff, IntegratorType::Implicit, 0.0));
+}
 const RunSummary& stiff_reference() {
-  static const RunSummary ref =
-      run_steps(stiff_scene(), IntegratorType::Implicit, kStiff, 0.1 * stiff_dt(), 10 * kStiffSteps);
+  static const RunSummary ref = run_steps(stiff_scene(), IntegratorType::Implicit, kStiff,
+                                          0.1 * stiff_dt(), 10 * kStiffSteps);
   return ref;
 }
 
@@ -166,7 +168,9 @@ const RunSummary& stiff_reference() {
 // distribution has an exponential tail, so the largest of ~100 forces is ~ ln(100) ~ 4.6 times
 // the mean: f_max ~ 12 Pi d. Bound: max overlap < 20 Pi_max d / kn (Pi_max = the largest sampled
 // pressure, a few P). Measured: 6.6 Pi_max / kn (implicit at 20 dt_stab), 6.4 (reference).
-double overlap_bound(const RunSummary& r) { return 20.0 * r.max_pressure / kStiff; }
+double overlap_bound(const RunSummary& r) {
+  return 20.0 * r.max_pressure / kStiff;
+}
 
 TEST(Integrators, ImplicitStableFarAboveExplicitLimit) {
   const RunSummary& ref = stiff_reference();
@@ -174,7 +178,8 @@ TEST(Integrators, ImplicitStableFarAboveExplicitLimit) {
   ASSERT_TRUE(ref.finite);
   EXPECT_LT(ref.max_overlap, overlap_bound(ref));
 
-  const RunSummary r = run_steps(stiff_scene(), IntegratorType::Implicit, kStiff, stiff_dt(), kStiffSteps);
+  const RunSummary r =
+      run_steps(stiff_scene(), IntegratorType::Implicit, kStiff, stiff_dt(), kStiffSteps);
   ASSERT_FALSE(r.failed);
   ASSERT_TRUE(r.finite);
   EXPECT_GT(r.max_pressure, 0.0);

@@ -35,9 +35,8 @@ Scene two_particle_scene(const Vec2& top, const Vec2& bottom, bool top_first, do
   sc.box.lx = kLx;
   sc.box.ly = kLy;
   sc.box.lees_edwards = true;
-  sc.box.gammadot = kGammadot;
   sc.box.le_offset = offset;
-  sc.flow = ShearFlow{kGammadot, 0.0};
+  sc.flow = ImposedFlow{kGammadot, 0.0};
   return sc;
 }
 
@@ -78,8 +77,8 @@ TEST_P(LeesEdwardsPair, AcrossTheBoundaryEqualsTheInteriorTwin) {
   EXPECT_EQ(pairs_in[0].kx, 0);
   const Box& box = le.dynamics().box();
   const Particles& p_le = le.dynamics().particles();
-  const Vec2 rij = p_le.position[1] + box.image_shift(pairs_le[0].kx, pairs_le[0].ky) -
-                   p_le.position[0];
+  const Vec2 rij =
+      p_le.position[1] + box.image_shift(pairs_le[0].kx, pairs_le[0].ky) - p_le.position[0];
   EXPECT_NEAR(rij.norm(), r, 1e-12);
 
   // Solve both at the current configuration (the first step's implicit dt is irrelevant:
@@ -88,8 +87,8 @@ TEST_P(LeesEdwardsPair, AcrossTheBoundaryEqualsTheInteriorTwin) {
   Velocities v_le, v_in;
   le.dynamics().begin_step();
   in.dynamics().begin_step();
-  ASSERT_EQ(le.dynamics().neighbours().pairs()[0].contact.active, pc.h < 0.0);
-  ASSERT_EQ(in.dynamics().neighbours().pairs()[0].contact.active, pc.h < 0.0);
+  ASSERT_EQ(le.dynamics().neighbours().pairs()[0].history.touching, pc.h < 0.0);
+  ASSERT_EQ(in.dynamics().neighbours().pairs()[0].history.touching, pc.h < 0.0);
   ASSERT_TRUE(le.dynamics().solve(dt, v_le));
   ASSERT_TRUE(in.dynamics().solve(dt, v_in));
 
@@ -115,7 +114,7 @@ TEST_P(LeesEdwardsPair, AcrossTheBoundaryEqualsTheInteriorTwin) {
 
   // Non-affine velocities U - U_inf of each particle (scale: gammadot d).
   const Particles& p_in = in.dynamics().particles();
-  const ShearFlow& flow = le.dynamics().flow();
+  const ImposedFlow& flow = le.dynamics().flow();
   double na_scale = 0.0;
   for (int k = 0; k < 2; ++k) {
     const Vec3 na_le = v_le.u[k] - flow.velocity(p_le.position[k]);
@@ -136,11 +135,11 @@ TEST_P(LeesEdwardsPair, AcrossTheBoundaryEqualsTheInteriorTwin) {
   const auto& q_in = in.dynamics().neighbours().pairs();
   ASSERT_EQ(q_le.size(), 1u);
   ASSERT_EQ(q_in.size(), 1u);
-  EXPECT_EQ(q_le[0].contact.active, q_in[0].contact.active);
-  EXPECT_NEAR(q_le[0].contact.xi, q_in[0].contact.xi,
-              1e-10 * std::max(std::abs(q_in[0].contact.xi), 1e-12));
+  EXPECT_EQ(q_le[0].history.touching, q_in[0].history.touching);
+  EXPECT_NEAR(q_le[0].history.contact.xi, q_in[0].history.contact.xi,
+              1e-10 * std::max(std::abs(q_in[0].history.contact.xi), 1e-12));
   if (pc.h < 0.0) {
-    EXPECT_NE(q_in[0].contact.xi, 0.0) << "the contact should have stretched";
+    EXPECT_NE(q_in[0].history.contact.xi, 0.0) << "the contact should have stretched";
   }
   // The offset advanced by gammadot Ly dt.
   EXPECT_NEAR(le.dynamics().box().le_offset, kOffset + kGammadot * kLy * le.integrator().last_dt(),
@@ -192,7 +191,6 @@ TEST_P(NeighbourBruteForce, ListEqualsAllImagePairsWithinCutoff) {
   box.lx = pk.lx;
   box.ly = pk.ly;
   box.lees_edwards = true;
-  box.gammadot = 0.1;
   box.le_offset = GetParam() * box.lx;
   // The default range of the engine: lubrication cut-off h_max = 0.5, skin 0.3.
   NeighbourList nl(1.25, 0.3);
@@ -250,9 +248,9 @@ TEST(LeesEdwardsWrap, CrossingInYShiftsXByTheOffset) {
   // Unwrapped positions are left alone.
   EXPECT_EQ(p.unwrapped[0], Vec2(5.0, kLy + 0.2));
   // Image velocities: +gammadot Ly for the image above.
-  box.gammadot = kGammadot;
-  EXPECT_DOUBLE_EQ(box.image_velocity_x(1), kGammadot * kLy);
-  EXPECT_DOUBLE_EQ(box.image_velocity_x(-1), -kGammadot * kLy);
+  const ImposedFlow flow{kGammadot, 0.0};
+  EXPECT_DOUBLE_EQ(flow.image_velocity_x(1, box.ly), kGammadot * kLy);
+  EXPECT_DOUBLE_EQ(flow.image_velocity_x(-1, box.ly), -kGammadot * kLy);
   const Vec2 shift = box.image_shift(-1, 1);
   EXPECT_DOUBLE_EQ(shift.x(), -kLx + kOffset);
   EXPECT_DOUBLE_EQ(shift.y(), kLy);

@@ -43,8 +43,8 @@ void expect_same_as_full_solve(const std::string& scene, Passes passes = Passes:
   std::vector<std::size_t> switched;
   int images = 0, walls = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    if (!pairs[k].contact.active || p.motion[pairs[k].j] == Motion::FloatingWall) continue;
-    pairs[k].contact.sliding = true;
+    if (!pairs[k].history.touching || p.motion[pairs[k].j] == Motion::FloatingWall) continue;
+    pairs[k].history.contact.sliding = true;
     switched.push_back(k);
     images += pairs[k].ky != 0;
     walls += p.motion[pairs[k].j] == Motion::FixedWall;
@@ -53,7 +53,7 @@ void expect_same_as_full_solve(const std::string& scene, Passes passes = Passes:
   if (scene == "simple_shear") {
     EXPECT_GT(images, 0) << "no Lees-Edwards image contact exercised";
   }
-  const WallDrive* wall = d.wall_drive();
+  const WallBodies* wall = d.wall_bodies();
 
   // Low-rank path: a solve with the contacts sliding, then switched to sticking.
   ForceBalance fast(lub, law, 3, true);
@@ -65,12 +65,12 @@ void expect_same_as_full_solve(const std::string& scene, Passes passes = Passes:
   if (passes == Passes::Two) {
     const std::vector<std::size_t> first(switched.begin(), switched.begin() + switched.size() / 2);
     const std::vector<std::size_t> second(switched.begin() + switched.size() / 2, switched.end());
-    for (std::size_t k : first) pairs[k].contact.sliding = false;
+    for (std::size_t k : first) pairs[k].history.contact.sliding = false;
     ASSERT_TRUE(fast.resolve_with_sticking(p, d.box(), d.flow(), pairs, first, dt, wall, v_fast));
-    for (std::size_t k : second) pairs[k].contact.sliding = false;
+    for (std::size_t k : second) pairs[k].history.contact.sliding = false;
     ASSERT_TRUE(fast.resolve_with_sticking(p, d.box(), d.flow(), pairs, second, dt, wall, v_fast));
   } else {
-    for (std::size_t k : switched) pairs[k].contact.sliding = false;
+    for (std::size_t k : switched) pairs[k].history.contact.sliding = false;
     ASSERT_TRUE(
         fast.resolve_with_sticking(p, d.box(), d.flow(), pairs, switched, dt, wall, v_fast));
   }

@@ -54,7 +54,9 @@ void expect_coefficients_near(const PairResistance& got, const PairResistance& w
     EXPECT_NEAR(g[k], w[k], rel * std::abs(w[k])) << names[k];
 }
 
-Vec2 unit(double angle) { return {std::cos(angle), std::sin(angle)}; }
+Vec2 unit(double angle) {
+  return {std::cos(angle), std::sin(angle)};
+}
 
 TEST(Lubrication, CoefficientsMatchClosedFormsForBothSizePairs) {
   const Lubrication lub{0.01, 0.5};
@@ -169,7 +171,9 @@ TEST(Lubrication, ContinuousAtContact) {
 
 // ---- The 6x6 block R_pair ------------------------------------------------------------------
 
-double max_abs(const Mat6& m) { return m.cwiseAbs().maxCoeff(); }
+double max_abs(const Mat6& m) {
+  return m.cwiseAbs().maxCoeff();
+}
 
 TEST(PairResistanceMatrix, SymmetricAndPositiveSemiDefinite) {
   const Lubrication lub{0.01, 0.5};
@@ -209,7 +213,8 @@ TEST(PairResistanceMatrix, ForceAndTorqueFollowTheModelFormulas) {
         const Vec2 ui = u.head<2>(), uj = u.segment<2>(3);
         const double wi = u[2], wj = u[5];
         const Vec2 du = ui - uj;
-        const Vec2 fi = -c.xa * n.dot(du) * n - c.ya * t.dot(du) * t - (c.beta_i * wi + c.beta_j * wj) * t;
+        const Vec2 fi =
+            -c.xa * n.dot(du) * n - c.ya * t.dot(du) * t - (c.beta_i * wi + c.beta_j * wj) * t;
         const double ti = -c.beta_i * t.dot(du) - c.gam_ii * wi - c.gam_ij * wj;
         const double tj = -c.beta_j * t.dot(du) - c.gam_ij * wi - c.gam_jj * wj;
         const double scale = c.matrix(n, t).cwiseAbs().maxCoeff() * u.cwiseAbs().maxCoeff();
@@ -300,20 +305,20 @@ TEST(PairResistanceMatrix, ForceBalanceUsesTheContactDashpotAtZeroGap) {
   pairs[0].i = 0;
   pairs[0].j = 1;
   ForceBalance::update_contacts(p, box, pairs);
-  ASSERT_TRUE(pairs[0].contact.active);
+  ASSERT_TRUE(pairs[0].history.touching);
   const Lubrication lub{0.01, 0.5};
   const FrictionalContact contact{1e4, 5e3, 0.5};
   ForceBalance fb(lub, contact, 3, true);
   fb.on_rebuild(p, pairs);
   Velocities v;
-  ASSERT_TRUE(fb.solve(p, box, ShearFlow{0.0, 0.0}, pairs, 0.0, nullptr, v));
+  ASSERT_TRUE(fb.solve(p, box, ImposedFlow{0.0, 0.0}, pairs, 0.0, nullptr, v));
   const PairTerm& term = fb.terms()[0];
   ASSERT_TRUE(term.on);
   const Mat6 want = lub.coefficients(0.5, 0.7, 0.0).matrix(term.g.n, term.g.t);
   EXPECT_LE(max_abs(term.m - want), 1e-13 * max_abs(want));
   // Implicit springs add exactly dt K.
   const double dt = 0.02;
-  ASSERT_TRUE(fb.solve(p, box, ShearFlow{0.0, 0.0}, pairs, dt, nullptr, v));
+  ASSERT_TRUE(fb.solve(p, box, ImposedFlow{0.0, 0.0}, pairs, dt, nullptr, v));
   const Mat6 want_k = want + dt * contact.stiffness(term.g, false);
   EXPECT_LE(max_abs(fb.terms()[0].m - want_k), 1e-13 * max_abs(want_k));
 }
@@ -426,8 +431,8 @@ TEST(FrictionalContact, TangentialStiffnessIsTheLinearisedSpringStretch) {
   Vec6 u;
   u << 0.01, -0.02, 0.3, -0.04, 0.015, -0.1;
   const double dt = 0.01, xi = 2e-5;
-  const Vec6 df = c.spring_force(g, xi + FrictionalContact::slip_rate(g, u) * dt) -
-                  c.spring_force(g, xi);
+  const Vec6 df =
+      c.spring_force(g, xi + FrictionalContact::slip_rate(g, u) * dt) - c.spring_force(g, xi);
   const Vec6 w = FrictionalContact::slip_mode(g);
   const Vec6 lin = -dt * c.kt * w * w.dot(u);
   ASSERT_GT(lin.norm(), 0.0);

@@ -120,7 +120,7 @@ TEST(SkipUnneeded, NoWallUnknownInSimpleShear) {
   Simulation sim(frictionless("simple_shear"));
   sim.step();
   EXPECT_FALSE(sim.dynamics().walls().has_value());
-  EXPECT_EQ(sim.dynamics().wall_drive(), nullptr);
+  EXPECT_EQ(sim.dynamics().wall_bodies(), nullptr);
   EXPECT_EQ(sim.dynamics().force_balance().system().wall_column().size(),
             static_cast<Eigen::Index>(sim.dynamics().force_balance().system().unknowns()));
   EXPECT_EQ(sim.dynamics().force_balance().system().wall_column().squaredNorm(), 0.0);
@@ -159,6 +159,8 @@ TEST(SkipUnneeded, UnrequestedObserversAreNotComposed) {
   EXPECT_EQ(make_observers(c, dir).size(), 2u);
   c.scene.type = "pressure_shear";
   c.analysis.diffusion = false;
+  EXPECT_EQ(make_observers(c, dir).size(), 3u);  // rheology, the pressure cell, its profiles
+  c.observables.profiles = false;
   EXPECT_EQ(make_observers(c, dir).size(), 2u);  // rheology and the pressure cell
 }
 

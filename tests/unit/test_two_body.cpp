@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -52,7 +51,6 @@ Scene two_body_scene(double ai, double aj, double h) {
   sc.box.lx = 20.0;
   sc.box.ly = 20.0;
   sc.box.lees_edwards = true;
-  sc.box.gammadot = 0.0;
   sc.flow.gammadot = 0.0;
   sc.flow.y0 = 0.0;
   return sc;
@@ -125,14 +123,15 @@ SqueezeResult run_squeeze(double ai, double aj, IntegratorType type, double dt, 
     ++res.checkpoints;
     // The discs stay on their line of centres and never touch (no contact forces involved).
     EXPECT_NEAR(g.n.y(), 0.0, 1e-12);
-    EXPECT_FALSE(sim.dynamics().neighbours().pairs().at(0).contact.active);
+    EXPECT_FALSE(sim.dynamics().neighbours().pairs().at(0).history.touching);
   }
   return res;
 }
 
-// Time to close from h = 0.3 to h ~ 0.018 (0.5/0.5) or 0.023 (0.5/0.7) for F = 1. Near contact (h + delta) decays
-// exponentially with rate lambda = (2/s) F / (6 pi 2 a_i^2 a_j^2 / s^3) (the XA-dominated limit
-// of -d rate/dh): 0.849 for 0.5/0.5 and 0.624 for 0.5/0.7, and |d rate/dh| <= lambda everywhere.
+// Time to close from h = 0.3 to h ~ 0.018 (0.5/0.5) or 0.023 (0.5/0.7) for F = 1. Near contact (h +
+// delta) decays exponentially with rate lambda = (2/s) F / (6 pi 2 a_i^2 a_j^2 / s^3) (the
+// XA-dominated limit of -d rate/dh): 0.849 for 0.5/0.5 and 0.624 for 0.5/0.7, and |d rate/dh| <=
+// lambda everywhere.
 constexpr double kSqueezeTimeEqual = 3.5;
 constexpr double kSqueezeTimeUnequal = 4.5;
 
@@ -142,8 +141,7 @@ constexpr double kSqueezeTimeUnequal = 4.5;
 // h >= 0.017. The bound 1e-5 leaves a factor > 15 for the nonlinearity of the rate (measured:
 // 2.9e-7 for 0.5/0.5, 1.3e-7 for 0.5/0.7).
 TEST(TwoBodySqueeze, HeunFollowsAnalyticOdeEqualSpheres) {
-  const SqueezeResult r =
-      run_squeeze(0.5, 0.5, IntegratorType::Heun, 1e-3, kSqueezeTimeEqual, 250);
+  const SqueezeResult r = run_squeeze(0.5, 0.5, IntegratorType::Heun, 1e-3, kSqueezeTimeEqual, 250);
   EXPECT_GE(r.checkpoints, 14);
   // The run covers the lubrication-dominated regime (rate ~ 1/XA) but stops before contact.
   EXPECT_LT(r.final_gap, 0.04);
@@ -183,8 +181,10 @@ TEST(TwoBodySqueeze, ConvergenceOrders) {
   const double t = 3.0;
   const double heun1 = run_squeeze(0.5, 0.7, IntegratorType::Heun, 0.02, t, 1000000).max_rel_error;
   const double heun2 = run_squeeze(0.5, 0.7, IntegratorType::Heun, 0.01, t, 1000000).max_rel_error;
-  const double euler1 = run_squeeze(0.5, 0.7, IntegratorType::Euler, 0.02, t, 1000000).max_rel_error;
-  const double euler2 = run_squeeze(0.5, 0.7, IntegratorType::Euler, 0.01, t, 1000000).max_rel_error;
+  const double euler1 =
+      run_squeeze(0.5, 0.7, IntegratorType::Euler, 0.02, t, 1000000).max_rel_error;
+  const double euler2 =
+      run_squeeze(0.5, 0.7, IntegratorType::Euler, 0.01, t, 1000000).max_rel_error;
   EXPECT_NEAR(heun1 / heun2, 4.0, 0.5) << heun1 << " " << heun2;
   EXPECT_NEAR(euler1 / euler2, 2.0, 0.25) << euler1 << " " << euler2;
 }
@@ -212,13 +212,13 @@ TEST(TwoBodyContact, SteadyOverlapIsForceOverStiffness) {
       sim.dynamics().particles_mut().external = {Vec3(kF, 0.0, 0.0), Vec3(-kF, 0.0, 0.0)};
       for (int k = 0; k < 1500; ++k) sim.step();
       const Pair& pr = sim.dynamics().neighbours().pairs().at(0);
-      EXPECT_TRUE(pr.contact.active);
+      EXPECT_TRUE(pr.history.touching);
       const double overlap = geometry(sim).overlap();
       EXPECT_NEAR(overlap * kn / kF, 1.0, 1e-6) << "overlap " << overlap;
       // Static: the solved velocities vanish (scale: F/zeta ~ 0.1 when free).
       for (const Vec3& u : sim.integrator().velocities().u) EXPECT_LT(u.norm(), 1e-8);
       // No tangential load: the spring is never stretched.
-      EXPECT_NEAR(pr.contact.xi, 0.0, 1e-15);
+      EXPECT_NEAR(pr.history.contact.xi, 0.0, 1e-15);
       (kn == 1e3 ? overlap_1e3 : overlap_1e4) = overlap;
     }
     // overlap ~ 1/k
@@ -239,7 +239,8 @@ TEST(TwoBodyContact, SteadyOverlapIsForceOverStiffness) {
 // The load is re-aligned with the current line of centres before every step.
 void set_contact_load(Simulation& sim, double fn, double ft) {
   Particles& p = sim.dynamics().particles_mut();
-  const PairGeometry g = PairGeometry::make(p.position[1] - p.position[0], p.radius[0], p.radius[1]);
+  const PairGeometry g =
+      PairGeometry::make(p.position[1] - p.position[0], p.radius[0], p.radius[1]);
   const Vec2 fi = fn * g.n - ft * g.t;
   p.external = {Vec3(fi.x(), fi.y(), -ft * g.ai), Vec3(-fi.x(), -fi.y(), -ft * g.aj)};
 }
@@ -256,11 +257,11 @@ ContactParams params_of(const Config& cfg) {
 // these runs, checked by the callers). Returns kt |xi| / (mu kn overlap).
 double coulomb_ratio(const Simulation& sim, const ContactParams& c) {
   const Pair& pr = sim.dynamics().neighbours().pairs().at(0);
-  if (!pr.contact.active) return 0.0;
+  if (!pr.history.touching) return 0.0;
   const double limit = c.mu * c.kn * std::max(geometry(sim).overlap(), 0.0);
-  EXPECT_LE(c.kt * std::abs(pr.contact.xi), limit * (1.0 + 1e-9))
-      << "step " << sim.dynamics().steps() << " xi " << pr.contact.xi;
-  return limit > 0.0 ? c.kt * std::abs(pr.contact.xi) / limit : 0.0;
+  EXPECT_LE(c.kt * std::abs(pr.history.contact.xi), limit * (1.0 + 1e-9))
+      << "step " << sim.dynamics().steps() << " xi " << pr.history.contact.xi;
+  return limit > 0.0 ? c.kt * std::abs(pr.history.contact.xi) / limit : 0.0;
 }
 
 // Sliding speed. At the cap kt xi = mu kn overlap, so the generalised force left on the pair is
@@ -274,7 +275,8 @@ double slip_mobility(const PairGeometry& g) {
   const double ai = g.ai, aj = g.aj, s = ai + aj, c = 6.0 * kPi;
   const double ln = 1.0 / kDelta, lt = std::log(1.0 / kDelta);
   const double xa = c * 2.0 * ai * ai * aj * aj / (s * s * s) * ln;
-  const double ya = c * (4.0 / 15.0) * ai * aj * (2 * ai * ai + ai * aj + 2 * aj * aj) / (s * s * s) * lt;
+  const double ya =
+      c * (4.0 / 15.0) * ai * aj * (2 * ai * ai + ai * aj + 2 * aj * aj) / (s * s * s) * lt;
   const double bi = c * (2.0 / 15.0) * ai * ai * aj * (4 * ai + aj) / (s * s) * lt;
   const double bj = c * (2.0 / 15.0) * ai * aj * aj * (ai + 4 * aj) / (s * s) * lt;
   const double gii = c * (8.0 / 15.0) * ai * ai * ai * aj / s * lt;
@@ -300,7 +302,8 @@ double slip_mobility(const PairGeometry& g) {
   r(5, 5) = gjj;
   const double di = 2 * ai, dj = 2 * aj;
   Vec6 drag;
-  drag << 3 * kPi * di, 3 * kPi * di, kPi * di * di * di, 3 * kPi * dj, 3 * kPi * dj, kPi * dj * dj * dj;
+  drag << 3 * kPi * di, 3 * kPi * di, kPi * di * di * di, 3 * kPi * dj, 3 * kPi * dj,
+      kPi * dj * dj * dj;
   r += drag.asDiagonal().toDenseMatrix();
   Vec6 w;
   w << g.t, ai, -g.t, aj;
@@ -312,7 +315,7 @@ double slip_mobility(const PairGeometry& g) {
 // every step and records the last step.
 struct SlidingRun {
   int steps = 0, at_limit = 0;
-  double ratio = 0.0;          // kt |xi| / (mu kn overlap) after the last step
+  double ratio = 0.0;  // kt |xi| / (mu kn overlap) after the last step
   double xi = 0.0;
   double slip = 0.0;           // slip rate of the last step's velocities
   double expected_slip = 0.0;  // (ft - mu kn overlap) w^T A^-1 w at the last step's geometry
@@ -333,10 +336,10 @@ SlidingRun run_sliding(IntegratorType type, double fn_rate) {
     set_contact_load(sim, run.fn, kFt);
     sim.step();
     const Pair& pr = sim.dynamics().neighbours().pairs().at(0);
-    EXPECT_TRUE(pr.contact.active) << "step " << k;
+    EXPECT_TRUE(pr.history.touching) << "step " << k;
     run.ratio = coulomb_ratio(sim, c);  // asserts kt |xi| <= mu kn overlap (1 + 1e-9)
     if (run.ratio >= 1.0 - 1e-9) ++run.at_limit;
-    run.xi = pr.contact.xi;
+    run.xi = pr.history.contact.xi;
     const PairGeometry& g = sim.dynamics().force_balance().terms().at(0).g;
     const auto& u = sim.integrator().velocities().u;
     Vec6 u6;
@@ -407,11 +410,11 @@ TEST(TwoBodyContact, StickingSpringCarriesTangentialLoad) {
     for (int k = 0; k < 5000; ++k) {
       set_contact_load(sim, kFn, kFt);
       sim.step();
-      ASSERT_TRUE(sim.dynamics().neighbours().pairs().at(0).contact.active) << "step " << k;
+      ASSERT_TRUE(sim.dynamics().neighbours().pairs().at(0).history.touching) << "step " << k;
       ratio = coulomb_ratio(sim, c);
     }
     const Pair& pr = sim.dynamics().neighbours().pairs().at(0);
-    EXPECT_NEAR(c.kt * pr.contact.xi / kFt, 1.0, 1e-6) << "xi " << pr.contact.xi;
+    EXPECT_NEAR(c.kt * pr.history.contact.xi / kFt, 1.0, 1e-6) << "xi " << pr.history.contact.xi;
     EXPECT_NEAR(geometry(sim).overlap() * c.kn / kFn, 1.0, 1e-6);
     // Stuck, below the cap: kt xi / (mu kn overlap) = ft / (mu fn) = 0.6.
     EXPECT_NEAR(ratio, kFt / (c.mu * kFn), 1e-6);
@@ -436,8 +439,8 @@ TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
       set_contact_load(sim, 1.0, 0.3);
       sim.step();
     }
-    ASSERT_TRUE(pairs.at(0).contact.active);
-    ASSERT_NEAR(c.kt * pairs.at(0).contact.xi, 0.3, 1e-3);
+    ASSERT_TRUE(pairs.at(0).history.touching);
+    ASSERT_NEAR(c.kt * pairs.at(0).history.contact.xi, 0.3, 1e-3);
 
     // Phase 2: reverse the normal load (no tangential load). Every step that starts with h > 0
     // must leave the contact inactive with xi exactly 0; while still overlapping, xi survives.
@@ -449,16 +452,15 @@ TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
       const Pair& pr = pairs.at(0);
       if (h_start > 0.0) {
         ++open_steps;
-        EXPECT_FALSE(pr.contact.active) << "h " << h_start;
-        EXPECT_EQ(pr.contact.xi, 0.0) << "h " << h_start;
+        EXPECT_FALSE(pr.history.touching) << "h " << h_start;
+        EXPECT_EQ(pr.history.contact.xi, 0.0) << "h " << h_start;
       } else {
         ++closed_steps;
-        EXPECT_TRUE(pr.contact.active) << "h " << h_start;
+        EXPECT_TRUE(pr.history.touching) << "h " << h_start;
         // The stretch is kept (relaxing, and capped by Coulomb with the end-of-step overlap)
         // while the contact lasts.
         coulomb_ratio(sim, c);
-        if (geometry(sim).overlap() > 0.0 && pr.contact.xi != 0.0)
-          ++stretched_steps;
+        if (geometry(sim).overlap() > 0.0 && pr.history.contact.xi != 0.0) ++stretched_steps;
       }
     }
     EXPECT_GT(closed_steps, 0);
@@ -476,8 +478,8 @@ TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
       set_contact_load(sim, 1.0, 0.3);
       sim.step();
       const Pair& pr = pairs.at(0);
-      if (!pr.contact.active) {
-        EXPECT_EQ(pr.contact.xi, 0.0);
+      if (!pr.history.touching) {
+        EXPECT_EQ(pr.history.contact.xi, 0.0);
         continue;
       }
       recontact = true;
@@ -489,9 +491,9 @@ TEST(TwoBodyContact, TangentialSpringResetsWhenContactOpens) {
       const double cap = c.mu * c.kn * std::max(geometry(sim).overlap(), 0.0) / c.kt;
       const double expected = std::clamp(vs * cfg.integrator.dt, -cap, cap);
       const double tol = type == IntegratorType::Implicit ? 1e-9 : 1e-2;
-      EXPECT_NEAR(pr.contact.xi, expected, 1e-15 + tol * std::abs(expected));
+      EXPECT_NEAR(pr.history.contact.xi, expected, 1e-15 + tol * std::abs(expected));
       // The old stretch (6e-4) is far above anything one step can build.
-      EXPECT_LT(std::abs(pr.contact.xi), 1e-5);
+      EXPECT_LT(std::abs(pr.history.contact.xi), 1e-5);
     }
     EXPECT_TRUE(recontact);
     EXPECT_EQ(sim.dynamics().neighbours().rebuilds(), rebuilds);
@@ -522,26 +524,26 @@ TEST(TwoBodyContact, SlidingContactReleasedAtLargeImplicitStepSticksAndRelaxes) 
     set_contact_load(sim, kFn, 0.8);
     sim.step();
   }
-  ASSERT_TRUE(pairs.at(0).contact.active);
+  ASSERT_TRUE(pairs.at(0).history.touching);
   ASSERT_NEAR(coulomb_ratio(sim, c), 1.0, 1e-9);
-  ASSERT_GT(pairs.at(0).contact.xi, 0.0);
+  ASSERT_GT(pairs.at(0).history.contact.xi, 0.0);
   // Phase 2: tangential load off. The slip mode relaxes at ~ kt / (dashpot + drag) ~ 400 per
   // unit time, i.e. by 1/(1 + 8) per implicit step: after 100 steps nothing is left.
   int sign_flips = 0;
-  double last_xi = pairs.at(0).contact.xi;
+  double last_xi = pairs.at(0).history.contact.xi;
   for (int k = 0; k < 100; ++k) {
     set_contact_load(sim, kFn, 0.0);
     sim.step();
-    const double xi = pairs.at(0).contact.xi;
+    const double xi = pairs.at(0).history.contact.xi;
     // Round-off (|xi| ~ 1e-21 once relaxed) may change sign; a chatter flips at the cap 1e-4.
     if (xi * last_xi < 0.0 && std::abs(xi) > 1e-12) ++sign_flips;
     last_xi = xi;
   }
   const Pair& pr = pairs.at(0);
-  ASSERT_TRUE(pr.contact.active);
+  ASSERT_TRUE(pr.history.touching);
   EXPECT_EQ(sign_flips, 0) << "the spring chatters between the Coulomb caps";
-  EXPECT_FALSE(pr.contact.sliding);
-  EXPECT_LT(c.kt * std::abs(pr.contact.xi), 1e-8) << "xi " << pr.contact.xi;
+  EXPECT_FALSE(pr.history.contact.sliding);
+  EXPECT_LT(c.kt * std::abs(pr.history.contact.xi), 1e-8) << "xi " << pr.history.contact.xi;
   for (const Vec3& u : sim.integrator().velocities().u) EXPECT_LT(u.norm(), 1e-8);
   EXPECT_EQ(sim.dynamics().neighbours().rebuilds(), rebuilds);
 }
@@ -558,8 +560,8 @@ TEST(TwoBodyContact, SlidingSpeedMatchesAnalyticImplicitLargeStep) {
     sim.step();
   }
   const Pair& pr = sim.dynamics().neighbours().pairs().at(0);
-  ASSERT_TRUE(pr.contact.active);
-  EXPECT_TRUE(pr.contact.sliding);
+  ASSERT_TRUE(pr.history.touching);
+  EXPECT_TRUE(pr.history.contact.sliding);
   EXPECT_NEAR(coulomb_ratio(sim, c), 1.0, 1e-9);
   const PairGeometry& g = sim.dynamics().force_balance().terms().at(0).g;
   const auto& u = sim.integrator().velocities().u;
@@ -581,7 +583,8 @@ namespace {
 // Coulomb cap (a ratio of the two stiffnesses) does not move.
 TEST(FrictionalContact, MeanRadiusStiffnessScalesEachPair) {
   const FrictionalContact uniform{1e4, 5e3, 0.5, false}, scaled{1e4, 5e3, 0.5, true};
-  for (const auto& [ai, aj, factor] : {std::tuple{0.5, 0.5, 1.0}, {0.5, 0.7, 1.2}, {0.7, 0.7, 1.4}}) {
+  for (const auto& [ai, aj, factor] :
+       {std::tuple{0.5, 0.5, 1.0}, {0.5, 0.7, 1.2}, {0.7, 0.7, 1.4}}) {
     const PairGeometry g = PairGeometry::make(Vec2(ai + aj - 0.003, 0.0), ai, aj);
     const Vec6 fu = uniform.spring_force(g, 1e-4), fs = scaled.spring_force(g, 1e-4);
     EXPECT_NEAR((fs - factor * fu).norm(), 0.0, 1e-12 * fu.norm());

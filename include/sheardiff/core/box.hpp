@@ -4,20 +4,18 @@
 namespace sheardiff {
 
 // The simulation cell. x is always periodic with length Lx. In y the cell is either
-// Lees-Edwards periodic (simple shear: the image at +Ly moves with +gammadot*Ly in x)
-// or bounded by walls (y extent given by the wall bodies, ly unused for images).
+// Lees-Edwards periodic (simple shear: the image at +Ly moves with the imposed flow's velocity
+// difference across Ly, ImposedFlow::image_velocity_x) or bounded by walls (y extent given by
+// the wall bodies, ly unused for images).
 struct Box {
   double lx = 1.0;
   double ly = 1.0;
   bool lees_edwards = false;
-  double gammadot = 0.0;
   // Unwrapped Lees-Edwards offset: x shift of the image at +Ly, = gammadot * Ly * t.
   double le_offset = 0.0;
 
   // Shift of the periodic image (kx, ky) at the current time.
   Vec2 image_shift(int kx, int ky) const { return {kx * lx + ky * le_offset, ky * ly}; }
-  // Extra velocity of the image (kx, ky) relative to the particle itself.
-  double image_velocity_x(int ky) const { return ky * gammadot * ly; }
 };
 
 }  // namespace sheardiff

@@ -7,19 +7,20 @@
 namespace sheardiff {
 
 // Where a particle's velocity comes from. Mobile particles carry unknowns; a particle of a
-// rigid wall body moves with that body (fixed, or floating in y).
-enum class Motion : std::uint8_t { Mobile = 0, FixedWall = 1, FloatingWall = 2 };
+// rigid wall body moves with that body (fixed, driven in x, or driven and floating in y;
+// core/walls.hpp).
+enum class Motion : std::uint8_t { Mobile = 0, FixedWall = 1, FloatingWall = 2, DrivenWall = 3 };
 
 // All discs of a scene. Mobile particles come first (indices 0 .. n_mobile-1), so the
 // unknown vector is indexed directly by particle index.
 struct Particles {
   std::size_t n_mobile = 0;
-  std::vector<Vec2> position;    // current centres (wrapped at neighbour rebuilds)
-  std::vector<Vec2> unwrapped;   // centres integrated without wrapping (for displacements)
-  std::vector<double> radius;    // a_i = d_i / 2
-  std::vector<int> species;      // 0 small, 1 large
+  std::vector<Vec2> position;   // current centres (wrapped at neighbour rebuilds)
+  std::vector<Vec2> unwrapped;  // centres integrated without wrapping (for displacements)
+  std::vector<double> radius;   // a_i = d_i / 2
+  std::vector<int> species;     // 0 small, 1 large
   std::vector<Motion> motion;
-  std::vector<Vec3> velocity;    // last solved (u_x, u_y, omega)
+  std::vector<Vec3> velocity;  // last solved (u_x, u_y, omega)
   // Optional imposed force and torque on mobile particles (empty = none); tests and
   // sedimentation-like scenes use it.
   std::vector<Vec3> external;

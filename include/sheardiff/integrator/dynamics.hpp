@@ -5,8 +5,9 @@
 
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/box.hpp"
+#include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
-#include "sheardiff/interactions/stokes_drag.hpp"
+#include "sheardiff/core/walls.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
 #include "sheardiff/solver/force_balance.hpp"
 
@@ -19,27 +20,19 @@ struct StepLimits {
   double max_gap_fraction = 0.5;   // of (gap + delta s / 2)
   double max_overlap_change = 1e-3;
   double max_strain_step = 1e-2;
-  double explicit_dt = 0.0;        // stability cap of explicit springs (0 = none)
-  double end_time = 0.0;           // a fixed dt is shortened to land on it (0 = none)
+  double explicit_dt = 0.0;  // stability cap of explicit springs (0 = none)
+  double end_time = 0.0;     // a fixed dt is shortened to land on it (0 = none)
 };
 
 // Which limit set a step (reported as fractions of steps in summary.json).
 enum class StepLimit : int { Fixed, Strain, Displacement, Gap, Overlap, Explicit, Growth, Count };
 const char* to_string(StepLimit l);
 
-// The two rough walls: the bottom one fixed, the top one driven at Vx = gammadot H and floating
-// in y under the load P Lx lz. Indices refer to Particles.
-struct WallBodies {
-  std::vector<int> bottom, top;
-  double load = 0.0;
-  double free_fall_cap = 1.0;
-};
-
 // The state of a run and the operations an integrator composes: solve for velocities at the
 // current configuration, pick a step, move everything by a step. No policy lives here.
 class Dynamics {
  public:
-  Dynamics(Particles particles, Box box, ShearFlow flow, ForceBalance force_balance,
+  Dynamics(Particles particles, Box box, ImposedFlow flow, ForceBalance force_balance,
            NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls);
 
   // Opens/closes contacts at the current configuration; call once at the start of a step.
@@ -77,7 +70,7 @@ class Dynamics {
 
   struct Saved {
     std::vector<Vec2> position, unwrapped;
-    std::vector<ContactHistory> contacts;
+    std::vector<PairHistory> contacts;
     Box box;
     double time;
   };
@@ -91,30 +84,30 @@ class Dynamics {
   Particles& particles_mut() { return particles_; }
   void rebuild_now() { rebuild(); }
   const Box& box() const { return box_; }
-  const ShearFlow& flow() const { return flow_; }
+  const ImposedFlow& flow() const { return flow_; }
   const NeighbourList& neighbours() const { return neighbours_; }
   const ForceBalance& force_balance() const { return force_balance_; }
   ForceBalance& force_balance() { return force_balance_; }
   const StepLimits& limits() const { return limits_; }
   const std::optional<WallBodies>& walls() const { return walls_; }
   double time() const { return time_; }
-  double strain() const { return flow_.gammadot * time_; }
+  // The run's clock (strain gammadot t for a shear).
+  double strain() const { return flow_.clock(time_); }
   long steps() const { return steps_; }
   // Gap between the walls (mean y of top minus bottom wall particles), or Ly.
   double height() const;
-  const WallDrive* wall_drive() const { return walls_ ? &drive_ : nullptr; }
+  const WallBodies* wall_bodies() const { return walls_ ? &*walls_ : nullptr; }
 
  private:
   void rebuild();
 
   Particles particles_;
   Box box_;
-  ShearFlow flow_;
+  ImposedFlow flow_;
   ForceBalance force_balance_;
   NeighbourList neighbours_;
   StepLimits limits_;
   std::optional<WallBodies> walls_;
-  WallDrive drive_;
   double time_ = 0.0;
   long steps_ = 0;
   bool rebuild_due_ = false;

@@ -1,18 +1,23 @@
 #pragma once
-#include "sheardiff/interactions/pair_geometry.hpp"
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/interactions/pair_law.hpp"
 
 namespace sheardiff {
-
-// State a contact carries from step to step.
-struct ContactHistory {
-  bool active = false;  // h <= 0 at the start of the current step
-  double xi = 0.0;      // scalar tangential spring stretch (2D)
-  bool sliding = false; // the last step capped xi at the Coulomb limit
-};
 
 // Linear spring contact with Coulomb friction (docs/model.md section 5). Forces act in the
 // 6-vector space (u_x, u_y, omega)_i, (u_x, u_y, omega)_j of the pair.
 struct FrictionalContact {
+  // State a contact carries from step to step (whether the pair touches is the pair's own,
+  // PairHistory::touching).
+  struct History {
+    double xi = 0.0;       // scalar tangential spring stretch (2D)
+    bool sliding = false;  // the last step capped xi at the Coulomb limit
+  };
+
   double kn = 1e4;
   double kt = 5e3;
   double mu = 0.5;
@@ -20,17 +25,18 @@ struct FrictionalContact {
   // (a_i + a_j) / d (1, 1.2, 1.4 for small-small, small-large, large-large at 1 : 1.4).
   bool scale_with_radius = false;
 
+  static std::optional<FrictionalContact> from(const Config& cfg) {
+    const double k = cfg.contact.ktilde;
+    return FrictionalContact{k, cfg.contact.kt_ratio * k, cfg.contact.mu,
+                             cfg.contact.stiffness == "mean_radius"};
+  }
+
   bool has_friction() const { return mu > 0.0 && kt > 0.0; }
   double scale(const PairGeometry& g) const { return scale_with_radius ? g.ai + g.aj : 1.0; }
   double kn_of(const PairGeometry& g) const { return kn * scale(g); }
   double kt_of(const PairGeometry& g) const { return kt * scale(g); }
 
-  // Normal direction in pair space: d(overlap)/dt = normal_mode . U.
-  static Vec6 normal_mode(const PairGeometry& g) {
-    Vec6 m;
-    m << g.n, 0.0, -g.n, 0.0;
-    return m;
-  }
+  static Vec6 normal_mode(const PairGeometry& g) { return sheardiff::normal_mode(g); }
   // Slip direction in pair space: slip rate v_s = -slip_mode . U.
   static Vec6 slip_mode(const PairGeometry& g) {
     Vec6 w;
@@ -71,6 +77,41 @@ struct FrictionalContact {
     }
     return false;
   }
+
+  // ---- The pair-law contract (pair_law.hpp) ----
+  double range_factor() const { return 1.0; }
+  bool acts(const PairGeometry&, bool touching) const { return touching; }
+  void add_block(const PairGeometry& g, const History& h, bool, double dt_implicit,
+                 PairBlock& b) const {
+    const bool friction = has_friction();
+    b.add_force(spring_force(g, friction ? h.xi : 0.0));
+    // Sliding is what the last Coulomb cap decided, not a re-test of |xi| against the new
+    // overlap: a growing overlap would otherwise turn a sliding contact sticky.
+    b.sliding = friction && h.sliding;
+    if (dt_implicit > 0.0) b.add_matrix(dt_implicit * stiffness(g, b.sliding));
+  }
+  bool resistive() const { return false; }
+  bool keeps_history() const { return has_friction(); }
+  // Springs stretch with the slip at the geometry of the start of the step ...
+  void advance(History& h, const PairGeometry& g, const Vec6& u, double dt) const {
+    h.xi += slip_rate(g, u) * dt;
+  }
+  // ... and are capped by Coulomb at its end, where their force is next evaluated, so that
+  // kt |xi| <= mu kn overlap holds at every force evaluation.
+  void cap(History& h, const PairGeometry& g) const { h.sliding = apply_coulomb(g, h.xi); }
+  // Implicit springs: a contact that entered the step sliding but whose solved slip u runs
+  // against its stretch unloads its spring, so it sticks (Coulomb: |f_t| < mu f_n). Returns
+  // whether it changed.
+  static bool stick_if_unloading(History& h, const PairGeometry& g, const Vec6& u) {
+    if (!h.sliding || !(slip_rate(g, u) * h.xi < 0.0)) return false;
+    h.sliding = false;
+    return true;
+  }
+  void add_stability(double, StabilityTerms& s) const {
+    s.normal_stiffness += kn;
+    if (has_friction()) s.tangential_stiffness += kt;
+  }
+  bool needs_rotations() const { return has_friction(); }
 };
 
 }  // namespace sheardiff

@@ -1,12 +1,15 @@
 #pragma once
-#include "sheardiff/interactions/pair_geometry.hpp"
+#include <optional>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/interactions/pair_law.hpp"
 
 namespace sheardiff {
 
 // Resistance coefficients of one pair, already multiplied by 6 pi eta (eta = 1).
 struct PairResistance {
-  double xa = 0, ya = 0;                    // squeeze, shear
-  double beta_i = 0, beta_j = 0;            // shear-rotation coupling
+  double xa = 0, ya = 0;                      // squeeze, shear
+  double beta_i = 0, beta_j = 0;              // shear-rotation coupling
   double gam_ii = 0, gam_jj = 0, gam_ij = 0;  // pump / rotation
 
   // The 6x6 block R_pair in the order (u_x, u_y, omega)_i, (u_x, u_y, omega)_j
@@ -17,14 +20,40 @@ struct PairResistance {
 // Leading singular lubrication between two discs of a monolayer (Ball & Melrose modes),
 // regularised by delta; also gives the contact dashpots (the same law frozen at h = 0).
 struct Lubrication {
+  using History = NoHistory;
+
   double delta = 0.01;
   double h_max = 0.5;
   // Off: squeeze mode only, so lubrication exerts no torque and needs no rotational unknowns.
   bool tangential = true;
 
+  static std::optional<Lubrication> from(const Config& cfg) {
+    if (!cfg.lubrication.enabled) return std::nullopt;
+    return Lubrication{cfg.lubrication.delta, cfg.lubrication.h_max, cfg.lubrication.tangential};
+  }
+
   bool acts(double h) const { return h < h_max; }
   // Coefficients at reduced gap h; h <= 0 (contact) is evaluated at h = 0 (dashpots).
   PairResistance coefficients(double ai, double aj, double h) const;
+
+  // ---- The pair-law contract (pair_law.hpp) ----
+  // h_max is a reduced gap, 2 r / (a_i + a_j) - 2.
+  double range_factor() const { return 1.0 + 0.5 * h_max; }
+  // A touching pair keeps its dashpots even if the geometry of a predictor moved it apart.
+  bool acts(const PairGeometry& g, bool touching) const { return touching || acts(g.h); }
+  void add_block(const PairGeometry& g, const History&, bool, double, PairBlock& b) const {
+    b.add_matrix(coefficients(g.ai, g.aj, g.h).matrix(g.n, g.t));
+  }
+  bool resistive() const { return true; }
+  bool keeps_history() const { return false; }
+  void advance(History&, const PairGeometry&, const Vec6&, double) const {}
+  void cap(History&, const PairGeometry&) const {}
+  void add_stability(double a, StabilityTerms& s) const {
+    const PairResistance r = coefficients(a, a, 0.0);
+    s.normal_damping += r.xa;
+    s.tangential_damping += r.ya;
+  }
+  bool needs_rotations() const { return tangential; }
 };
 
 }  // namespace sheardiff

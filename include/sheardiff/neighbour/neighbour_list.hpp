@@ -5,17 +5,23 @@
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/box.hpp"
 #include "sheardiff/core/particles.hpp"
-#include "sheardiff/interactions/contact.hpp"
+#include "sheardiff/interactions/pair_laws.hpp"
 
 namespace sheardiff {
 
 // One listed pair. i is always mobile; j is mobile or a wall particle. j is seen through the
-// periodic image (kx, ky) of the box. Wall-wall pairs are never listed.
+// periodic image (kx, ky) of the box. Wall-wall pairs are never listed. history: what the pair
+// laws keep for it from step to step (pair_laws.hpp), carried while the pair touches.
 struct Pair {
   int i = 0, j = 0;
   int kx = 0, ky = 0;
-  ContactHistory contact;
+  PairHistory history;
 };
+
+// The vector from i to (the image of) j of a listed pair, at the current positions and offset.
+inline Vec2 pair_separation(const Particles& p, const Box& box, const Pair& pr) {
+  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
+}
 
 // Verlet list built with a nanoflann k-d tree over the particles and their periodic
 // (and Lees-Edwards shifted) images. Every pair within s (1 + h_max/2) + skin is listed;
@@ -26,7 +32,7 @@ class NeighbourList {
   NeighbourList(double interaction_range_factor, double skin)
       : range_factor_(interaction_range_factor), skin_(skin) {}
 
-  // Wraps positions into the box, rebuilds the list, and carries the contact history of
+  // Wraps positions into the box, rebuilds the list, and carries the history of touching
   // pairs that are still listed.
   void rebuild(Particles& p, const Box& box);
   // Accumulate the motion since the last rebuild; na = non-affine displacement of each

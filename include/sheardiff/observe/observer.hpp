@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -10,6 +11,10 @@
 namespace sheardiff {
 
 class H5mdWriter;
+
+// Whether the run is in its measured window now (after the transient, or from a detected
+// steady state): what observers that average only over it are given.
+using MeasuredWindow = std::function<bool(const Dynamics&)>;
 
 // What an observer sees after a step.
 struct StepView {

@@ -3,36 +3,9 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/observe/observer.hpp"
+#include "sheardiff/observe/profiles.hpp"
 
 namespace sheardiff {
-
-// Area of the disc (centre height yc, radius a) lying between heights y1 < y2.
-double disc_area_between(double yc, double a, double y1, double y2);
-
-// phi(y), u_x(y) and the fluctuation temperature T(y) = <u'.u'> of the mobile discs across the
-// gap, in bins of `bin` d measured from the bottom wall's centre line, averaged with any weight
-// (dt during a run, 1 per frame when recomputed from a trajectory).
-class GapProfiles {
- public:
-  explicit GapProfiles(double bin) : bin_(bin) {}
-  void add(const Particles& p, const std::vector<Vec3>& u, double y_bottom, double height,
-           double lx, double weight);
-  bool empty() const { return w_.empty(); }
-  // Rows = bins; columns y (bin centre), phi, u_x, T.
-  Eigen::MatrixXd table() const;
-  // The table into summary: profile_{y, phi, u_x, T} with velocities over gammadot, and the
-  // shear rate of the bulk (a line fit of u_x over the bins at least `exclusion` from both
-  // walls) over the imposed gammadot = V / H.
-  void to_summary(nlohmann::json& js, double gammadot, double height, double exclusion) const;
-  void serialize(Archive& a) {
-    a.io(lx_);
-    for (auto* v : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_}) a.io(*v);
-  }
-
- private:
-  double bin_, lx_ = 1.0;
-  std::vector<double> w_, area_, n_, ux_, ux2_, uy2_;
-};
 
 // Statistical errors of the steady window's H, phi, mu, mu_top, mu_bottom from frame samples
 // (batch means over blocks of `block` strain from `from` to `to`): *_err keys into summary.
@@ -43,7 +16,7 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
 
 // Observables of the pressure-imposed plane shear cell (docs/model.md section 9): gap H, bulk phi,
 // mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
-// drift of H and mu, and phi(y), u_x(y), T(y) profiles averaged over the steady window.
+// drift of H and mu (its profiles across the gap: ProfilesObserver, over the steady window).
 class PressureCellObserver final : public Observer {
  public:
   explicit PressureCellObserver(const Config& cfg);
@@ -62,7 +35,6 @@ class PressureCellObserver final : public Observer {
                       &p_meas_, &max_p_err_})
       a.io(*x);
     a.io(free_fall_steps_);
-    profiles_.serialize(a);
     for (auto* v : {&s_strain_, &s_h_, &s_phi_, &s_mu_top_, &s_mu_bottom_}) a.io(*v);
   }
 
@@ -81,7 +53,6 @@ class PressureCellObserver final : public Observer {
   double w_ = 0, h_ = 0, phi_ = 0, phi2_ = 0, mu_top_ = 0, mu_bottom_ = 0, p_meas_ = 0;
   double max_p_err_ = 0;
   long free_fall_steps_ = 0;
-  GapProfiles profiles_;
   // Frame samples of the steady window, for the error bars.
   std::vector<double> s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_;
 };

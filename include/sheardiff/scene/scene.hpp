@@ -1,10 +1,14 @@
 #pragma once
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/core/box.hpp"
+#include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
-#include "sheardiff/integrator/dynamics.hpp"
+#include "sheardiff/core/walls.hpp"
+#include "sheardiff/scene/registry.hpp"
 
 namespace sheardiff {
 
@@ -12,16 +16,11 @@ namespace sheardiff {
 struct Scene {
   Particles particles;
   Box box;
-  ShearFlow flow;
+  ImposedFlow flow;
   std::optional<WallBodies> walls;
 };
 
-// Lees-Edwards periodic cell at fixed area fraction and shear rate (volume imposed).
-Scene build_simple_shear(const Config& cfg);
-// Plane shear between two rough walls of frozen particles, periodic in x; the bottom wall
-// fixed, the top wall driven at gammadot H and floating in y under the load P Lx lz.
-Scene build_pressure_shear(const Config& cfg);
-// Dispatch on scene.type.
+// The scene cfg asks for, built.
 Scene build_scene(const Config& cfg);
 
 }  // namespace sheardiff

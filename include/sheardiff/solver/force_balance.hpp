@@ -3,22 +3,15 @@
 #include <vector>
 
 #include "sheardiff/core/box.hpp"
+#include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
-#include "sheardiff/interactions/contact.hpp"
-#include "sheardiff/interactions/lubrication.hpp"
+#include "sheardiff/core/walls.hpp"
+#include "sheardiff/interactions/pair_laws.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
 
 namespace sheardiff {
-
-// The rigid top wall: x velocity imposed, y velocity solved so that the suspension pushes on it
-// with exactly `load` = P Lx lz (docs/model.md section 6).
-struct WallDrive {
-  double vx = 0.0;
-  double load = 0.0;
-  double free_fall_cap = 1.0;  // |V| bound while nothing (or almost nothing) holds the wall
-};
 
 // What one pair contributes this step: its geometry, its matrix block M (resistance, plus
 // dt K for implicit springs) and its spring force f; the pair's generalised force is
@@ -29,7 +22,7 @@ struct PairTerm {
   Mat6 m = Mat6::Zero();
   Vec6 f = Vec6::Zero();
   Vec3 image_j = Vec3::Zero();
-  bool on = false;       // inside the lubrication range or in contact
+  bool on = false;       // some pair law acts on the pair
   bool sliding = false;  // contact at its Coulomb limit at the start of the step
 
   Vec6 force(const Vec3& ui, const Vec3& uj) const {
@@ -46,37 +39,56 @@ struct Velocities {
 };
 
 // Pair laws + drag -> the linear system -> velocities. One loop over the listed pairs serves
-// every pair law; absent laws (no lubrication, frictionless) cost nothing inside it.
+// every pair law (PairLaws, unrolled at compile time); absent laws cost nothing inside it. The
+// per-pair histories the laws keep are advanced and capped here too.
 class ForceBalance {
  public:
   // implicit_springs: the integrator will pass dt_implicit > 0, so contacts couple particles
   // in the matrix even without lubrication.
+  ForceBalance(PairLaws laws, int dof, bool implicit_springs,
+               const std::string& cholesky = "cholmod");
+  // Lubrication (or none) and contacts, no other law.
   ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact, int dof,
-               bool implicit_springs, const std::string& cholesky = "cholmod");
+               bool implicit_springs, const std::string& cholesky = "cholmod")
+      : ForceBalance(PairLaws(lubrication, contact, std::nullopt), dof, implicit_springs,
+                     cholesky) {}
 
   // The neighbour list changed: new sparsity pattern and symbolic analysis.
   void on_rebuild(const Particles& p, const std::vector<Pair>& pairs);
-  // Open/close contacts from the current geometry (a new contact starts with xi = 0).
+  // Open/close contacts from the current geometry (a new contact starts with a fresh history).
   static void update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs);
+  // The laws' per-pair histories over a step of length dt with velocities u, at the positions
+  // of its start (call before the move) ...
+  void advance_histories(const Particles& p, const Box& box, const ImposedFlow& flow,
+                         std::vector<Pair>& pairs, const std::vector<Vec3>& u, double dt) const;
+  // ... and their caps at its end (after the move).
+  void cap_histories(const Particles& p, const Box& box, std::vector<Pair>& pairs) const;
+  // Implicit springs: contacts that entered the step sliding but whose solved slip unloads
+  // their spring stick (FrictionalContact::stick_if_unloading); returns how many changed and
+  // their indices into pairs in *switched (optional).
+  int stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
+                             const std::vector<Vec3>& u, std::vector<std::size_t>* switched) const;
 
   // Assemble at the current positions and solve. dt_implicit > 0 treats the springs linearly
-  // implicitly over a step of that length. wall = nullptr when there is no floating wall.
-  bool solve(const Particles& p, const Box& box, const ShearFlow& flow,
-             const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall,
+  // implicitly over a step of that length. walls = nullptr when the scene has none; a floating
+  // top wall's y velocity is solved so that the suspension pushes on it with exactly its load
+  // (docs/model.md section 6).
+  bool solve(const Particles& p, const Box& box, const ImposedFlow& flow,
+             const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls,
              Velocities& out);
   // Implicit springs: the contacts `switched` (indices into pairs) have just been marked
   // sticking after a solve at the same positions and dt_implicit; solves again with their
   // tangential stiffness added as low-rank terms to the factor of the last solve (no new
   // assembly or factorisation; a full solve() if one of them touches the floating wall).
-  bool resolve_with_sticking(const Particles& p, const Box& box, const ShearFlow& flow,
+  bool resolve_with_sticking(const Particles& p, const Box& box, const ImposedFlow& flow,
                              const std::vector<Pair>& pairs,
                              const std::vector<std::size_t>& switched, double dt_implicit,
-                             const WallDrive* wall, Velocities& out);
+                             const WallBodies* walls, Velocities& out);
   // The two halves of solve(), separately for benchmarks: pair terms and matrix, then the
   // factorisation and back-substitution.
-  void assemble(const Particles& p, const Box& box, const ShearFlow& flow,
-                const std::vector<Pair>& pairs, double dt_implicit, const WallDrive* wall);
-  bool solve_assembled(const Particles& p, const ShearFlow& flow, const WallDrive* wall,
+  void assemble(const Particles& p, const Box& box, const ImposedFlow& flow,
+                const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls);
+  bool solve_assembled(const Particles& p, const ImposedFlow& flow, const WallBodies* walls,
                        Velocities& out);
 
   const std::vector<PairTerm>& terms() const { return terms_; }
@@ -85,19 +97,19 @@ class ForceBalance {
   // Most low-rank terms per factorisation before a re-solve refactorises (0: from the
   // factorisation's flop count, the default).
   void set_max_low_rank_terms(std::size_t n) { system_.set_max_low_rank_terms(n); }
-  const std::optional<Lubrication>& lubrication() const { return lubrication_; }
-  const FrictionalContact& contact() const { return contact_; }
+  const PairLaws& laws() const { return laws_; }
+  const std::optional<Lubrication>& lubrication() const { return laws_.get<Lubrication>(); }
+  const FrictionalContact& contact() const { return *laws_.get<FrictionalContact>(); }
   // |A U + b V - g| / |g| of the last solve.
   double last_residual() const { return residual_; }
   void set_check_residual(bool on) { check_residual_ = on; }
 
  private:
   template <bool kWalls>
-  void assemble_pairs(const Particles& p, const Box& box, const std::vector<Pair>& pairs,
-                      double dt_implicit, const WallDrive* wall);
+  void assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
+                      const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls);
 
-  std::optional<Lubrication> lubrication_;
-  FrictionalContact contact_;
+  PairLaws laws_;
   ResistanceSystem system_;
   bool diagonal_only_;
   std::vector<PairTerm> terms_;

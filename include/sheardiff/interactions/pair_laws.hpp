@@ -1,0 +1,143 @@
+#pragma once
+// The pair laws of the engine and the generic operations over them (pair_law.hpp has the
+// contract). A new law is its header plus its config rows and one entry in PairLaws below (and,
+// if it keeps a per-contact history, one member of PairHistory).
+#include <algorithm>
+#include <optional>
+#include <tuple>
+#include <type_traits>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/interactions/contact.hpp"
+#include "sheardiff/interactions/lubrication.hpp"
+#include "sheardiff/interactions/pair_law.hpp"
+#include "sheardiff/interactions/repulsion.hpp"
+
+namespace sheardiff {
+
+// What one listed pair carries from step to step: whether it touches (decided at the start of a
+// step, shared by every law) and the history of each law that keeps one. Trivially copyable: it
+// is checkpointed as raw bytes with the neighbour list.
+struct PairHistory {
+  bool touching = false;
+  FrictionalContact::History contact;
+};
+
+// The history of law L inside a pair's record.
+template <class L>
+decltype(auto) history_of(PairHistory& h) {
+  if constexpr (std::is_same_v<typename L::History, FrictionalContact::History>)
+    return (h.contact);
+  else
+    return typename L::History{};
+}
+template <class L>
+decltype(auto) history_of(const PairHistory& h) {
+  if constexpr (std::is_same_v<typename L::History, FrictionalContact::History>)
+    return (h.contact);
+  else
+    return typename L::History{};
+}
+
+// The laws of one run, each present or not; every loop over them is unrolled at compile time.
+template <class... Laws>
+class PairLawSet {
+ public:
+  PairLawSet() = default;
+  explicit PairLawSet(std::optional<Laws>... laws) : laws_(std::move(laws)...) {}
+  static PairLawSet from(const Config& cfg) { return PairLawSet(Laws::from(cfg)...); }
+
+  template <class L>
+  const std::optional<L>& get() const {
+    return std::get<std::optional<L>>(laws_);
+  }
+  template <class L>
+  std::optional<L>& get() {
+    return std::get<std::optional<L>>(laws_);
+  }
+  // f(law) for every present law, in the order of the list.
+  template <class F>
+  void for_each(F&& f) const {
+    std::apply([&](const auto&... law) { ((law ? f(*law) : void()), ...); }, laws_);
+  }
+  template <class F>
+  bool any(F&& f) const {
+    bool r = false;
+    for_each([&](const auto& law) { r = r || f(law); });
+    return r;
+  }
+
+  // Largest pair range over (a_i + a_j): the neighbour list's cut-off without its skin.
+  double range_factor() const {
+    double r = 1.0;
+    for_each([&](const auto& law) { r = std::max(r, law.range_factor()); });
+    return r;
+  }
+  bool needs_rotations() const {
+    return any([](const auto& law) { return law.needs_rotations(); });
+  }
+  bool resistive() const {
+    return any([](const auto& law) { return law.resistive(); });
+  }
+  bool keeps_history() const {
+    return any([](const auto& law) { return law.keeps_history(); });
+  }
+  // Stability limit 2 R / k of explicit springs (docs/model.md section 7): the fastest mode is
+  // the smallest pair (two small discs), relaxing at rate k / R with R its laws' damping at
+  // contact plus the drag of two drag-bound discs.
+  double explicit_stability_dt() const {
+    const double a = 0.5;
+    const double drag = 3.0 * kPi * 2.0 * a / 2.0;
+    StabilityTerms s;
+    s.normal_damping = s.tangential_damping = drag;
+    for_each([&](const auto& law) { law.add_stability(a, s); });
+    double dt = 2.0 * s.normal_damping / s.normal_stiffness;
+    if (s.tangential_stiffness > 0.0)
+      dt = std::min(dt, 2.0 * s.tangential_damping / s.tangential_stiffness);
+    return dt;
+  }
+
+  // The block and force of one pair from every law acting on it; false if none acts (then m
+  // and f are left as they were).
+  bool add_blocks(const PairGeometry& g, const PairHistory& h, double dt_implicit, Mat6& m, Vec6& f,
+                  bool& sliding) const {
+    bool on = false;
+    PairBlock b{m, f, sliding};
+    for_each([&](const auto& law) {
+      using L = std::decay_t<decltype(law)>;
+      if (!law.acts(g, h.touching)) return;
+      if (!on) {
+        m.setZero();
+        f.setZero();
+        sliding = false;
+        on = true;
+      }
+      law.add_block(g, history_of<L>(h), h.touching, dt_implicit, b);
+    });
+    return on;
+  }
+  // The histories of a touching pair over a step (geometry of its start, pair velocity u) ...
+  void advance(PairHistory& h, const PairGeometry& g, const Vec6& u, double dt) const {
+    for_each([&](const auto& law) {
+      using L = std::decay_t<decltype(law)>;
+      if constexpr (!std::is_same_v<typename L::History, NoHistory>)
+        if (law.keeps_history()) law.advance(history_of<L>(h), g, u, dt);
+    });
+  }
+  // ... and capped at its end.
+  void cap(PairHistory& h, const PairGeometry& g) const {
+    for_each([&](const auto& law) {
+      using L = std::decay_t<decltype(law)>;
+      if constexpr (!std::is_same_v<typename L::History, NoHistory>)
+        if (law.keeps_history()) law.cap(history_of<L>(h), g);
+    });
+  }
+
+ private:
+  std::tuple<std::optional<Laws>...> laws_;
+};
+
+// The engine's pair laws, in the order their blocks are added.
+using PairLaws = PairLawSet<Lubrication, FrictionalContact, DoubleLayerRepulsion>;
+
+}  // namespace sheardiff

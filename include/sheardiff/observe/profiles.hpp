@@ -1,0 +1,71 @@
+#pragma once
+// Profiles across the gap of a scene with walls (docs/model.md section 9): phi(y), u_x(y), the
+// fluctuation temperature T(y) = <u'.u'> and the stresses sigma_xy(y) and p(y), in bins measured
+// from the bottom wall's centre line, averaged over the run's measured window.
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/observe/observer.hpp"
+
+namespace sheardiff {
+
+// Area of the disc (centre height yc, radius a) lying between heights y1 < y2.
+double disc_area_between(double yc, double a, double y1, double y2);
+
+// The profiles' accumulators, with any weight (dt during a run, 1 per frame when recomputed
+// from a trajectory).
+class GapProfiles {
+ public:
+  explicit GapProfiles(double bin) : bin_(bin) {}
+  // phi, u_x and T from the mobile discs and their velocities u; y_bottom: the bottom wall's
+  // centre line, height: the gap.
+  void add(const Particles& p, const std::vector<Vec3>& u, double y_bottom, double height,
+           double lx, double weight);
+  // The pair stresses of the step (sigma = -sum l n f / V): each pair's share in the bin of its
+  // midpoint; lz: the monolayer's thickness.
+  void add_stress(const Dynamics& d, const Velocities& v, double y_bottom, double lz,
+                  double weight);
+  bool empty() const { return w_.empty(); }
+  // Rows = bins; columns y (bin centre), phi, u_x, T.
+  Eigen::MatrixXd table() const;
+  // The table into summary: profile_{y, phi, u_x, T} with velocities over gammadot (and, when
+  // measured, profile_shear_stress and profile_pressure in P), and the shear rate of the bulk
+  // (a line fit of u_x over the bins at least `exclusion` from both walls) over the imposed
+  // gammadot = V / H.
+  void to_summary(nlohmann::json& js, double gammadot, double height, double exclusion) const;
+  void serialize(Archive& a) {
+    a.io(lx_);
+    for (auto* v : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_, &sxy_, &sp_}) a.io(*v);
+  }
+
+ private:
+  void grow(std::size_t bins);
+  double bin_, lx_ = 1.0;
+  std::vector<double> w_, area_, n_, ux_, ux2_, uy2_, sxy_, sp_;
+};
+
+// The profiles as an observer of any scene with walls, over the measured window.
+class ProfilesObserver final : public Observer {
+ public:
+  ProfilesObserver(const Config& cfg, MeasuredWindow measuring)
+      : profiles_(cfg.observables.profile_bin),
+        exclusion_(cfg.observables.wall_exclusion),
+        lz_(cfg.flow.lz),
+        measuring_(std::move(measuring)) {}
+  void on_step(const StepView& v) override;
+  void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
+  void serialize(Archive& a) override {
+    a.tag("profiles");
+    a.io(w_), a.io(h_);
+    profiles_.serialize(a);
+  }
+
+ private:
+  GapProfiles profiles_;
+  double exclusion_, lz_;
+  MeasuredWindow measuring_;
+  double w_ = 0.0, h_ = 0.0;  // measured time and time integral of the gap
+};
+
+}  // namespace sheardiff

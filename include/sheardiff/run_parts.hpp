@@ -1,0 +1,106 @@
+#pragma once
+// The parts a run in a directory is made of (run_to_directory, src/simulation.cpp composes them):
+// the evolving state of the run and its checkpoint store, the trajectory output, the progress
+// lines and the summary.
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "sheardiff/io/checkpoint_file.hpp"
+#include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/run_directory.hpp"
+#include "sheardiff/observe/observer.hpp"
+#include "sheardiff/observe/run_health.hpp"
+#include "sheardiff/simulation.hpp"
+
+namespace sheardiff {
+
+// Everything of a run that evolves: the simulation, its health checks and observers, and the
+// bookkeeping of its outputs.
+struct RunningState {
+  RunningState(const Config& cfg, const std::filesystem::path& out_dir, std::int64_t started_at);
+
+  Simulation sim;
+  RunHealth health;
+  std::vector<std::unique_ptr<Observer>> observers;
+  double next_frame, next_checkpoint;
+  double elapsed_before = 0.0;  // seconds run before this process (a resumed run)
+  long frames = 0;
+  // When the run started (a resumed run: its first start), as Unix seconds; -1: unknown.
+  std::int64_t started;
+
+  Dynamics& dynamics() { return sim.dynamics(); }
+  // Whether an observer, run.strain or run.max_steps ends the run now.
+  bool finished(const Config& cfg) const;
+  // The strain the run will end at, as far as it is known now (the progress line's end).
+  double planned_end_strain(const Config& cfg) const;
+};
+
+// The trajectory (H5MD) of a run, or nothing with output.trajectory = false.
+class TrajectoryOutput {
+ public:
+  // resume: append to the file cut back to the checkpoint's frames.
+  TrajectoryOutput(const Config& cfg, const RunningState& run, const RunDirectory& dir,
+                   const std::string& resolved, bool resume);
+  void write_frame(const Config& cfg, const RunningState& run, const std::vector<double>& values);
+  void flush() {
+    if (writer_) writer_->flush();
+  }
+  // Every half minute, so that a killed run leaves readable frames.
+  void flush_now_and_then();
+  H5mdWriter* writer() { return writer_.get(); }
+  void close();
+
+ private:
+  std::unique_ptr<H5mdWriter> writer_;
+  std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::now();
+};
+
+// checkpoint.bin: the whole RunningState in one fixed order, written atomically, read back
+// bit-identically; refused if it was written for another configuration.
+class CheckpointStore {
+ public:
+  CheckpointStore(std::filesystem::path file, std::string resolved_config, std::string out_dir)
+      : file_(std::move(file)), resolved_(std::move(resolved_config)), out_(std::move(out_dir)) {}
+  // Throws ConfigError (another configuration) or CorruptCheckpoint.
+  void load(RunningState& run, CheckpointPayload payload) const;
+  // elapsed_now: seconds this process has run; the trajectory is flushed first so that it holds
+  // every frame the checkpoint counts.
+  void save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory) const;
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  void serialize(Archive& a, RunningState& run, bool with_counters) const;
+  std::filesystem::path file_;
+  std::string resolved_, out_;
+};
+
+// Progress on stderr: a live line redrawn on a terminal (not logged), and a timestamped line
+// every `seconds` off a terminal, or in run.log alone (a terminal, --quiet).
+class RunProgress {
+ public:
+  RunProgress(RunDirectory& dir, bool progress, double seconds);
+  // Seconds since this process started the run.
+  double elapsed() const;
+  void update(const Config& cfg, const RunningState& run);
+  // Ends a live line before anything else is printed.
+  void end_line();
+
+ private:
+  RunDirectory& dir_;
+  bool progress_, tty_;
+  double seconds_;
+  std::chrono::steady_clock::time_point t0_, last_print_, last_line_;
+  bool shown_ = false;
+};
+
+// summary.json of a finished run: who ran what, the step statistics, and every observer's and
+// the health checks' results (observers may also write tables into the trajectory).
+nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
+                           RunDirectory& dir, TrajectoryOutput& trajectory);
+
+}  // namespace sheardiff

@@ -1,0 +1,95 @@
+#include "result_text.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace sheardiff {
+
+namespace {
+
+// A summary value, NaN when absent or not a number: summaries of older versions or of runs
+// that ended early lack some keys, and printing must not abort on them.
+double num(const nlohmann::json& js, const char* key) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_number() ? it->get<double>() : NAN;
+}
+double num_at(const nlohmann::json& js, const char* key, std::size_t i) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_array() && i < it->size() && (*it)[i].is_number()
+             ? (*it)[i].get<double>()
+             : NAN;
+}
+bool flag(const nlohmann::json& js, const char* key) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_boolean() && it->get<bool>();
+}
+long count(const nlohmann::json& js, const char* key) {
+  const auto it = js.find(key);
+  return it != js.end() && it->is_number() ? it->get<long>() : 0L;
+}
+
+}  // namespace
+
+std::string run_result_first_line(const nlohmann::json& summary, const std::string& out_dir) {
+  return fmt::format(
+      "{}: strain {:.4g} in {} steps, {:.1f} s ({:.3g} ms/step); max overlap {:.3g} d\n", out_dir,
+      num(summary, "strain"), count(summary, "steps"), num(summary, "wall_seconds"),
+      num(summary, "ms_per_step"), num(summary, "max_overlap"));
+}
+
+std::string run_result_details(const nlohmann::json& summary) {
+  std::string details;
+  if (summary.contains("steady")) {
+    if (!flag(summary, "steady")) {
+      details +=
+          fmt::format("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
+                      num(summary, "phi"));
+    } else {
+      details += fmt::format(
+          "  steady from strain {:.3g}: phi = {:.4f} +- {:.2g}, mu = {:.4f} +- {:.2g}, H = "
+          "{:.3f} d (+- statistical errors, time blocks)\n",
+          num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_err"),
+          num(summary, "mu"), num(summary, "mu_err"), num(summary, "H"));
+      details += fmt::format(
+          "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
+          "held steps)\n",
+          num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
+          count(summary, "steps") - count(summary, "wall_free_fall_steps"));
+    }
+  } else if (std::isnan(num(summary, "shear_stress"))) {
+    details += fmt::format("  no averages: the run ended before run.transient_strain\n");
+  } else {
+    details += fmt::format(
+        "  shear stress {:.5g} P, particle pressure {:.5g} P, viscosity {:.4g} eta\n",
+        num(summary, "shear_stress"), num(summary, "pressure"), num(summary, "viscosity"));
+  }
+  if (summary.contains("D"))
+    details += fmt::format(
+        "  diffusion: D = {:.4g} +- {:.2g} gammadot d^2 (MSD window [{:g}, {:g}]), dv = {:.4g} "
+        "+- {:.2g} gammadot d, Psi = {:.4g} +- {:.2g} / gammadot\n",
+        num(summary, "D"), num(summary, "D_err"), num_at(summary, "msd_window", 0),
+        num_at(summary, "msd_window", 1), num(summary, "dv"), num(summary, "dv_err"),
+        num(summary, "psi"), num(summary, "psi_err"));
+  return details;
+}
+
+std::string analysis_result_text(const nlohmann::json& js, const std::string& run_dir) {
+  return fmt::format(
+      "{}: D = {:.4g} +- {:.2g} gammadot d^2 over strain window [{:g}, {:g}] "
+      "(log-log slope {:.3f}); dv = {:.4g} +- {:.2g} gammadot d; Psi = {:.4g} +- {:.2g} / "
+      "gammadot; step length {:.4g} d\n",
+      run_dir, num(js, "D"), num(js, "D_err"), num_at(js, "msd_window", 0),
+      num_at(js, "msd_window", 1), num(js, "msd_window_slope"), num(js, "dv"), num(js, "dv_err"),
+      num(js, "psi"), num(js, "psi_err"), num(js, "step_length"));
+}
+
+void print_warnings(const nlohmann::json& js) {
+  const auto it = js.find("analysis_warnings");
+  if (it == js.end() || !it->is_array()) return;
+  for (const auto& w : *it)
+    if (w.is_string()) fmt::print(stderr, "warning: {}\n", w.get<std::string>());
+}
+
+}  // namespace sheardiff

@@ -1,0 +1,136 @@
+#include "sheardiff/observe/profiles.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sheardiff/analysis/power_law.hpp"
+
+namespace sheardiff {
+
+double disc_area_between(double yc, double a, double y1, double y2) {
+  // Area of the disc below height y: a^2 (pi/2 + u sqrt(1-u^2) + asin u), u = (y - yc)/a.
+  const auto below = [&](double y) {
+    const double u = std::clamp((y - yc) / a, -1.0, 1.0);
+    return a * a * (0.5 * kPi + u * std::sqrt(1.0 - u * u) + std::asin(u));
+  };
+  return y2 > y1 ? below(y2) - below(y1) : 0.0;
+}
+
+void GapProfiles::grow(std::size_t bins) {
+  if (w_.size() < bins)
+    for (auto* vec : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_}) vec->resize(bins, 0.0);
+}
+
+void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb, double height,
+                      double lx, double weight) {
+  lx_ = lx;
+  grow(static_cast<std::size_t>(std::ceil((height + 2.0) / bin_)));
+  for (double& x : w_) x += weight;
+  const auto bins = static_cast<long>(w_.size());
+  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+    const double y = p.position[i].y() - yb, a = p.radius[i];
+    const auto lo = static_cast<long>(std::floor((y - a) / bin_));
+    const auto hi = static_cast<long>(std::floor((y + a) / bin_));
+    for (long b = std::max(0L, lo); b <= hi && b < bins; ++b)
+      area_[b] += weight * disc_area_between(y, a, b * bin_, (b + 1) * bin_);
+    const long c = static_cast<long>(std::floor(y / bin_));
+    if (c < 0 || c >= bins) continue;
+    const Vec3& v = u[i];
+    n_[c] += weight;
+    ux_[c] += weight * v.x();
+    ux2_[c] += weight * v.x() * v.x();
+    uy2_[c] += weight * v.y() * v.y();
+  }
+}
+
+void GapProfiles::add_stress(const Dynamics& d, const Velocities& v, double yb, double lz,
+                             double weight) {
+  const auto bins = static_cast<long>(w_.size());
+  if (bins == 0) return;
+  sxy_.resize(w_.size(), 0.0);
+  sp_.resize(w_.size(), 0.0);
+  const double volume = d.box().lx * bin_ * lz;
+  const auto& pairs = d.neighbours().pairs();
+  const auto& terms = d.force_balance().terms();
+  const Particles& p = d.particles();
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const PairTerm& t = terms[k];
+    if (!t.on) continue;
+    const Pair& pr = pairs[k];
+    const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y() - yb;
+    // A pair with a wall disc may have its midpoint just outside the bins: the nearest one.
+    const long c = std::clamp(static_cast<long>(std::floor(mid / bin_)), 0L, bins - 1);
+    // The same pair stress as measure_stress (observe/stress.cpp), binned.
+    const Vec2 fj = t.force(v.u[pr.i], v.u[pr.j]).segment<2>(3);
+    const double l = pr.history.touching ? t.g.r : t.g.s;
+    const double sxx = -l * t.g.n.x() * fj.x(), syy = -l * t.g.n.y() * fj.y();
+    sxy_[c] += weight * -0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x()) / volume;
+    sp_[c] += weight * -0.5 * (sxx + syy) / volume;
+  }
+}
+
+Eigen::MatrixXd GapProfiles::table() const {
+  const auto nb = static_cast<Eigen::Index>(w_.size());
+  Eigen::MatrixXd t(nb, 4);
+  for (Eigen::Index b = 0; b < nb; ++b) {
+    const double n = n_[b];
+    const double ux = n > 0 ? ux_[b] / n : 0.0;
+    t(b, 0) = (static_cast<double>(b) + 0.5) * bin_;
+    t(b, 1) = w_[b] > 0 ? area_[b] / (w_[b] * lx_ * bin_) : 0.0;
+    t(b, 2) = ux;
+    t(b, 3) = n > 0 ? ux2_[b] / n - ux * ux + uy2_[b] / n : 0.0;
+  }
+  return t;
+}
+
+void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
+                             double exclusion) const {
+  if (empty() || !(gammadot > 0.0)) return;
+  const Eigen::MatrixXd t = table();
+  std::vector<double> y, phi, ux, temp, yb, uxb;
+  for (Eigen::Index b = 0; b < t.rows(); ++b) {
+    y.push_back(t(b, 0));
+    phi.push_back(t(b, 1));
+    ux.push_back(t(b, 2) / gammadot);
+    temp.push_back(t(b, 3) / (gammadot * gammadot));
+    if (n_[b] > 0 && t(b, 0) >= exclusion && t(b, 0) <= height - exclusion)
+      yb.push_back(t(b, 0)), uxb.push_back(t(b, 2) / gammadot);
+  }
+  js["profile_y"] = y;
+  js["profile_phi"] = phi;
+  js["profile_u_x"] = ux;  // in gammadot d (the imposed flow is y)
+  js["profile_T"] = temp;  // in (gammadot d)^2
+  js["profile_bin"] = bin_;
+  if (yb.size() >= 3) js["bulk_shear_rate_ratio"] = fit_line(yb, uxb).slope;
+  if (sxy_.size() == w_.size()) {
+    std::vector<double> sxy(w_.size()), sp(w_.size());
+    for (std::size_t b = 0; b < w_.size(); ++b) {
+      sxy[b] = w_[b] > 0 ? sxy_[b] / w_[b] : 0.0;
+      sp[b] = w_[b] > 0 ? sp_[b] / w_[b] : 0.0;
+    }
+    js["profile_shear_stress"] = sxy;  // sigma_xy of the pair forces, P
+    js["profile_pressure"] = sp;       // -(sigma_xx + sigma_yy) / 2 of the pair forces, P
+  }
+}
+
+void ProfilesObserver::on_step(const StepView& v) {
+  const Dynamics& d = v.dynamics;
+  if (!d.walls() || !measuring_(d)) return;
+  const double w = v.dt;
+  // The bottom wall is fixed: its centre line is the profiles' origin for the whole run.
+  const double yb = mean_height(d.particles(), d.walls()->bottom);
+  w_ += w;
+  h_ += w * d.height();
+  profiles_.add(d.particles(), v.velocities.u, yb, d.height(), d.box().lx, w);
+  profiles_.add_stress(d, v.velocities, yb, lz_, w);
+}
+
+void ProfilesObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
+  // Into summary.json (written whole or not at all), not into the trajectory: an HDF5 file
+  // killed while its metadata is being changed can be left unreadable, and the end of a run
+  // must be resumable at every instant (tests/cli/final_phase_kill.sh).
+  (void)writer;
+  if (w_ > 0.0) profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
+}
+
+}  // namespace sheardiff

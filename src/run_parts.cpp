@@ -1,0 +1,286 @@
+#include "sheardiff/run_parts.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+#include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/version.hpp"
+
+namespace sheardiff {
+
+namespace {
+
+// A reader's runtime_error on a checkpoint whose checksum held means another build's state
+// layout; on an unchecked (version 2) one, corruption. Either way it is not resumed.
+[[noreturn]] void unreadable_checkpoint(const std::filesystem::path& file, const char* what) {
+  throw CorruptCheckpoint(fmt::format(
+      "{} cannot be read: {}. It was neither resumed nor changed; keep a copy if you need it, "
+      "then start the run again with --overwrite",
+      file.string(), what));
+}
+
+// Whether the resolved text a checkpoint holds is this configuration: an older sheardiff wrote
+// it with other keys or other float digits (0.69999999999999996 for 0.7).
+bool same_config_text(const std::string& text, const std::string& resolved) {
+  if (text == resolved) return true;
+  try {
+    return to_toml(parse_config(text, "checkpoint.bin")) == resolved;
+  } catch (const ConfigError&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+// ---- RunningState --------------------------------------------------------------------------
+
+RunningState::RunningState(const Config& cfg, const std::filesystem::path& out_dir,
+                           std::int64_t started_at)
+    : sim(cfg),
+      health(cfg, sim.dynamics()),
+      observers(make_observers(cfg, out_dir)),
+      next_frame(cfg.output.frame_strain),
+      next_checkpoint(cfg.output.checkpoint_strain),
+      started(started_at) {
+  // The residual is one sparse product per solve, small next to the factorisation.
+  sim.dynamics().force_balance().set_check_residual(true);
+}
+
+bool RunningState::finished(const Config& cfg) const {
+  const Dynamics& d = sim.dynamics();
+  for (const auto& o : observers)
+    if (o->done(d)) return true;
+  return d.strain() >= cfg.run.strain * (1.0 - 1e-12) ||
+         (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
+}
+
+double RunningState::planned_end_strain(const Config& cfg) const {
+  // A pressure cell that has found its steady state stops at steady + measure_strain.
+  double end = cfg.run.strain;
+  for (const auto& o : observers) end = std::min(end, o->planned_end_strain());
+  return end;
+}
+
+// ---- TrajectoryOutput ----------------------------------------------------------------------
+
+TrajectoryOutput::TrajectoryOutput(const Config& cfg, const RunningState& run,
+                                   const RunDirectory& dir, const std::string& resolved,
+                                   bool resume) {
+  if (!cfg.output.trajectory) return;
+  const Dynamics& d = run.sim.dynamics();
+  const Particles& p = d.particles();
+  TrajectoryLayout layout;
+  for (const auto& o : run.observers) {
+    for (auto& n : o->frame_names()) layout.observables.push_back(n);
+    for (auto& u : o->frame_units()) layout.observable_units.push_back(u);
+  }
+  layout.n_particles = p.size();
+  layout.species = p.species;
+  for (double a : p.radius) layout.diameter.push_back(2.0 * a);
+  for (Motion m : p.motion) layout.motion.push_back(static_cast<int>(m));
+  layout.lx = d.box().lx;
+  layout.ly = d.height();
+  layout.lees_edwards = d.box().lees_edwards;
+  layout.write_velocity = cfg.output.velocities;
+  layout.write_contacts = cfg.output.contacts;
+  layout.author = cfg.output.author;
+  layout.creator_version = SHEARDIFF_VERSION;
+  layout.config_toml = resolved;
+  const auto file = dir.file("trajectory.h5");
+  writer_ = resume ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, run.frames))
+                   : std::make_unique<H5mdWriter>(file, layout);
+}
+
+void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
+                                   const std::vector<double>& values) {
+  if (!writer_) return;
+  const Dynamics& d = run.sim.dynamics();
+  FrameData f;
+  f.step = d.steps();
+  f.time = d.time();
+  f.lx = d.box().lx;
+  f.ly = d.height();
+  f.tilt = d.box().le_offset;
+  f.position = &d.particles().position;
+  f.unwrapped = &d.particles().unwrapped;
+  f.velocity = &run.sim.integrator().velocities().u;
+  f.observables = values;
+  ContactNetwork contacts;
+  if (cfg.output.contacts) contacts = contact_network(d);
+  f.contacts = &contacts;
+  writer_->write_frame(f);
+}
+
+void TrajectoryOutput::flush_now_and_then() {
+  if (!writer_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_flush_ > std::chrono::seconds(30)) {
+    writer_->flush();
+    last_flush_ = now;
+  }
+}
+
+void TrajectoryOutput::close() {
+  flush();
+  writer_.reset();
+}
+
+// ---- CheckpointStore -----------------------------------------------------------------------
+
+// The whole evolving state of the run, in one fixed order for saving and loading.
+// with_counters: version 3 checkpoints also hold the solver's work counters, and after them
+// the run's start time (absent from those of a sheardiff before it: then unknown).
+void CheckpointStore::serialize(Archive& a, RunningState& run, bool with_counters) const {
+  std::string config = resolved_;
+  a.io(config);
+  if (!same_config_text(config, resolved_))
+    throw ConfigError(fmt::format(
+        "--resume {}: the configuration differs from the one the checkpoint was written with "
+        "(see {}/config.toml)",
+        out_, out_));
+  Dynamics& d = run.dynamics();
+  d.serialize(a);
+  run.sim.serialize_integrator(a);
+  for (auto& o : run.observers) o->serialize(a);
+  run.health.serialize(a);
+  a.io(run.next_frame), a.io(run.next_checkpoint), a.io(run.elapsed_before), a.io(run.frames);
+  if (with_counters) {
+    d.force_balance().system().serialize_counters(a);
+    if (!a.loading() || !a.at_end())
+      a.io(run.started);
+    else
+      run.started = -1;
+  }
+}
+
+void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
+  Archive a = Archive::reader(std::move(payload.bytes));
+  try {
+    serialize(a, run, payload.checksummed);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    unreadable_checkpoint(file_, e.what());
+  }
+  if (!a.at_end()) unreadable_checkpoint(file_, "bytes are left after the state");
+}
+
+void CheckpointStore::save(RunningState& run, double elapsed_now,
+                           TrajectoryOutput& trajectory) const {
+  trajectory.flush();  // the trajectory holds every frame the checkpoint counts
+  Archive a = Archive::writer();
+  double total = run.elapsed_before + elapsed_now;
+  std::swap(total, run.elapsed_before);
+  serialize(a, run, true);
+  std::swap(total, run.elapsed_before);
+  // Whole or absent: a checkpoint is never half-written.
+  const std::vector<char> bytes = checkpoint_file_bytes(a.bytes());
+  write_file_atomically(file_, bytes.data(), bytes.size());
+}
+
+// ---- RunProgress ---------------------------------------------------------------------------
+
+RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds)
+    : dir_(dir),
+      progress_(progress),
+      tty_(progress && dir.terminal()),
+      seconds_(seconds),
+      t0_(std::chrono::steady_clock::now()),
+      last_print_(t0_),
+      last_line_(t0_) {}
+
+double RunProgress::elapsed() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+}
+
+void RunProgress::update(const Config& cfg, const RunningState& run) {
+  const auto now = std::chrono::steady_clock::now();
+  const bool live = tty_ && now - last_print_ > std::chrono::milliseconds(500);
+  const bool line = std::chrono::duration<double>(now - last_line_).count() > seconds_;
+  if (!live && !line) return;
+  const Dynamics& d = run.sim.dynamics();
+  const double el = std::chrono::duration<double>(now - t0_).count();
+  const double end = run.planned_end_strain(cfg);
+  const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
+  const std::string text =
+      fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
+                  d.steps(), static_cast<double>(d.steps()) / el, duration_text(eta));
+  if (live) {
+    std::fprintf(stderr, "\r%s   ", text.c_str());
+    last_print_ = now;
+    shown_ = true;
+  }
+  if (line) {
+    const std::string stamped = fmt::format("{}  {}\n", iso8601_utc_now(), text);
+    if (progress_ && !tty_)
+      std::fputs(stamped.c_str(), stderr);
+    else
+      dir_.log_only(stamped);
+    last_line_ = now;
+  }
+}
+
+void RunProgress::end_line() {
+  if (shown_) std::fprintf(stderr, "\n");
+  shown_ = false;
+}
+
+// ---- The summary ---------------------------------------------------------------------------
+
+nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
+                           RunDirectory& dir, TrajectoryOutput& trajectory) {
+  const Dynamics& d = run.sim.dynamics();
+  const Particles& p = d.particles();
+  nlohmann::json js;
+  js["version"] = version();
+  js["git_hash"] = git_hash();
+  js["host"] = host_name();
+  js["seed"] = cfg.run.seed;
+  if (run.started >= 0)
+    js["started"] =
+        iso8601_utc(std::chrono::system_clock::time_point(std::chrono::seconds(run.started)));
+  else
+    js["started"] = nullptr;
+  js["finished"] = iso8601_utc_now();
+  js["scene"] = cfg.scene.type;
+  js["N"] = cfg.particles.n;
+  js["J"] = cfg.flow.j;
+  js["ktilde"] = cfg.contact.ktilde;
+  js["integrator"] = to_string(cfg.integrator.type);
+  js["strain"] = d.strain();
+  js["steps"] = d.steps();
+  js["steps_per_strain"] = d.steps() / std::max(d.strain(), 1e-300);
+  js["wall_seconds"] = wall_seconds;
+  js["ms_per_step"] = 1e3 * wall_seconds / static_cast<double>(std::max<long>(d.steps(), 1));
+  js["neighbour_rebuilds"] = d.neighbours().rebuilds();
+  js["factorisations"] = d.force_balance().system().factorisations();
+  {
+    // Which limit set the steps: where the step count comes from.
+    nlohmann::json by;
+    const auto& counts = d.step_limit_counts();
+    for (int k = 0; k < static_cast<int>(StepLimit::Count); ++k)
+      if (counts[k] > 0)
+        by[to_string(static_cast<StepLimit>(k))] =
+            static_cast<double>(counts[k]) / static_cast<double>(std::max<long>(d.steps(), 1));
+    js["dt_limited_by"] = by;
+  }
+  js["lx"] = d.box().lx;
+  js["ly"] = d.height();
+  dir.with_hdf5_reasons([&] {
+    for (const auto& o : run.observers) o->finish(d, js, trajectory.writer());
+  });
+  run.health.report(js);
+  if (!js.contains("phi")) {
+    double area = 0;
+    for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
+    js["phi"] = area / (d.box().lx * d.height());
+  }
+  return js;
+}
+
+}  // namespace sheardiff
