@@ -8,6 +8,7 @@
 
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/stress.hpp"
 #include "sheardiff/version.hpp"
 
@@ -159,9 +160,20 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, bool with_counter
 }
 
 void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
+  // Layout 4 moved the gap profiles out of the pressure cell's section (ProfilesObserver): an
+  // older pressure-cell state cannot be placed, and reading it would fail half-way as "corrupt".
+  if (payload.layout < 4)
+    for (const auto& o : run.observers)
+      if (dynamic_cast<const PressureCellObserver*>(o.get()) != nullptr)
+        throw CorruptCheckpoint(fmt::format(
+            "{} was written by an earlier sheardiff (checkpoint layout {}), whose pressure-cell "
+            "state this version stores differently. It was neither resumed nor changed: finish "
+            "the run with the sheardiff that started it (its version and git hash are at the top "
+            "of {}/run.log), or start it again with --overwrite",
+            file_.string(), payload.layout, out_));
   Archive a = Archive::reader(std::move(payload.bytes));
   try {
-    serialize(a, run, payload.checksummed);
+    serialize(a, run, payload.layout >= 3);
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {

@@ -14,10 +14,12 @@ namespace sheardiff {
 
 namespace {
 
-constexpr char kMagic[] = "sheardiff-checkpoint-3";
+// The digit is the state layout (CheckpointPayload::layout); 3 and 4 share the header.
+constexpr char kMagic[] = "sheardiff-checkpoint-4";
+constexpr char kLayout3Magic[] = "sheardiff-checkpoint-3";
 constexpr char kLegacyMagic[] = "sheardiff-checkpoint-2";
 constexpr std::uint64_t kMagicLength = sizeof(kMagic) - 1;
-static_assert(sizeof(kLegacyMagic) == sizeof(kMagic));
+static_assert(sizeof(kLegacyMagic) == sizeof(kMagic) && sizeof(kLayout3Magic) == sizeof(kMagic));
 constexpr std::size_t kHeader = 8 + kMagicLength + 8 + 4;
 
 template <class T>
@@ -73,10 +75,13 @@ CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
   CheckpointPayload out;
   if (starts_with_magic(b, kLegacyMagic)) {
     out.checksummed = false;
+    out.layout = 2;
     out.bytes.assign(b.begin() + 8 + kMagicLength, b.end());
     return out;
   }
-  if (!starts_with_magic(b, kMagic))
+  if (starts_with_magic(b, kLayout3Magic))
+    out.layout = 3;
+  else if (!starts_with_magic(b, kMagic))
     throw corrupt(
         fmt::format("it does not begin with the magic \"{}\" ({} bytes)", kMagic, b.size()));
   if (b.size() < kHeader) throw corrupt(fmt::format("{} bytes, shorter than its header", b.size()));

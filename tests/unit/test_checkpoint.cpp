@@ -32,12 +32,10 @@ fs::path binary() {
 }
 
 // A small pressure-cell run with every observer on, long enough to be killed in the middle.
-fs::path write_config(const fs::path& dir) {
+fs::path write_config(const fs::path& dir, const std::string& scene = "pressure_shear") {
   fs::create_directories(dir);
   const auto file = dir / "run.toml";
-  std::ofstream(file) << R"([scene]
-type = "pressure_shear"
-[particles]
+  std::ofstream(file) << "[scene]\ntype = \"" << scene << "\"\n" << R"([particles]
 N = 80
 phi_init = 0.72
 [flow]
@@ -273,11 +271,12 @@ TEST(Checkpoint, ArchiveLengthsAreBoundedByTheFile) {
 }
 
 // Checkpoints of sheardiff before issue 16 (version 2: no header, no checksum, no solver
-// counters) still resume, with a warning, to the same results.
+// counters) still resume, with a warning, to the same results: those of a simple-shear run,
+// whose state layout has not changed since (a pressure cell's has: the next test).
 TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   const fs::path root = fs::temp_directory_path() / "sheardiff_test_v2";
   fs::remove_all(root);
-  const fs::path cfg = write_config(root);
+  const fs::path cfg = write_config(root, "simple_shear");
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
   const std::vector<char> v3 = bytes_of(root / "old" / "checkpoint.bin");
@@ -294,6 +293,27 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0);
   EXPECT_NE(text_of(root / "err.txt").find("has no checksum"), std::string::npos);
   expect_same_final_state(root / "whole", root / "old", /*with_counters=*/false);
+  fs::remove_all(root);
+}
+
+// A pressure-cell checkpoint of layout 3 (before the gap profiles became their own observer)
+// cannot be placed in today's state: refused before anything is read, with that reason and the
+// way out (the sheardiff that started it), exit 2, the file left as it was.
+TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_layout3";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  make_interrupted_run(cfg, root / "old");
+  std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
+  const std::string now = "sheardiff-checkpoint-4", before = "sheardiff-checkpoint-3";
+  ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
+  std::memcpy(bytes.data() + 8, before.data(), before.size());  // the CRC covers the payload only
+  write_bytes(root / "old" / "checkpoint.bin", bytes);
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 2);
+  const std::string err = text_of(root / "err.txt");
+  EXPECT_NE(err.find("earlier sheardiff (checkpoint layout 3)"), std::string::npos) << err;
+  EXPECT_NE(err.find("run.log"), std::string::npos) << err;
+  EXPECT_EQ(bytes_of(root / "old" / "checkpoint.bin"), bytes);
   fs::remove_all(root);
 }
 
