@@ -5,9 +5,11 @@ writes) whose points vary one setting (the axis, e.g. integrator.max_displacemen
 seeds.
 
 Per value of the axis: the mean over seeds of phi, mu, dv, Psi, D and the largest overlap, each
-+- the standard error of that mean from the seeds' scatter, the cost (steps and run seconds per
-strain), and each quantity's difference from the reference value of the axis (default: the
-smallest) in two units:
++- the standard error of that mean, the cost (steps and run seconds per strain), and each
+quantity's difference from the reference value of the axis (default: the smallest) in two units.
+The standard error is the larger of the seeds' scatter (s / sqrt(n)) and what the runs' own error
+bars give for the mean (rms of `<q>_err` over sqrt(n)): with two to four seeds the scatter alone
+is itself uncertain by 35-70 % and can be small by chance. Units of the difference:
   * z   = difference / combined standard error: |z| > 2 is a resolved bias;
   * r   = difference / the reference's standard error: the accuracy criterion of
           docs/performance.md is |r| <= 1/2 (within half the statistical error). With a few
@@ -68,11 +70,17 @@ def main():
         sys.exit(f"--reference {ref_value}: no finished point has {axis} = {ref_value}")
 
     def stats(rs, q):
-        return mean_sem([float(r[q]) for r in rs if r.get(q) not in (None, "")])
+        m, e = mean_sem([float(r[q]) for r in rs if r.get(q) not in (None, "")])
+        errs = [float(r[q + "_err"]) for r in rs if r.get(q + "_err") not in (None, "")]
+        if m is not None and errs and len(errs) == len(rs):
+            own = math.sqrt(sum(x * x for x in errs) / len(errs)) / math.sqrt(len(errs))
+            e = own if e is None else max(e, own)
+        return m, e
 
     ref = {q: stats(groups[ref_value], q) for q, _ in QUANTITIES}
     print(f"{sum(len(v) for v in groups.values())} finished points; axis {axis}, reference "
-          f"{ref_value:g}. Cells: mean over seeds +- standard error of the mean; "
+          f"{ref_value:g}. Cells: mean over seeds +- standard error of the mean (the larger of the "
+          f"seeds' scatter and the runs' own error bars); "
           f"(z, r) = difference from the reference in combined standard errors and in the "
           f"reference's standard error.\n")
     print("| " + axis + " | seeds | " + " | ".join(h for _, h in QUANTITIES)

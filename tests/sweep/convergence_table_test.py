@@ -2,7 +2,8 @@
 """tools/convergence_table.py on a synthetic sweep.csv with a known answer: three values of a
 setting, four seeds each; the coarsest carries a bias of exactly 4 reference standard errors in
 dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
-seed values), and an unknown axis must be refused. Usage: convergence_table_test.py REPO WORK"""
+seed values); runs' own error bars larger than their scatter set the mean's error; and an
+unknown axis must be refused. Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
 import subprocess
@@ -36,6 +37,18 @@ assert "(" not in cells[2], f"phi cell {cells[2]!r}: equal seeds have no error, 
 line = next(l for l in out.splitlines() if l.startswith("| 0.001 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[4].endswith("(+0.0, +0.0)"), f"dv cell {cells[4]!r}: want no bias"
+# Runs whose own error bars exceed their scatter: the mean's error is rms(psi_err) / sqrt(n).
+cols.append("psi_err")
+for r in rows:
+    r["psi_err"] = 1.0
+with open(work / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=cols)
+    w.writeheader()
+    w.writerows(rows)
+out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[5].endswith("+- 0.5"), f"psi cell {cells[5]!r}: want the runs' own error 1/sqrt(4)"
 bad = subprocess.run(tool + ["--axis", "flow.J"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--axis" in bad.stderr, bad.stderr
 print("convergence_table: ok")
