@@ -1,11 +1,13 @@
 # The git commit of the source tree, for `sheardiff --version` and every summary.json:
 # `git rev-parse --short HEAD`, with "-dirty" if a tracked file differs from HEAD, or "unknown"
 # where SOURCE_DIR is not the top of a git checkout (a tarball, an unpacked copy inside another
-# repository) or git is missing. Evaluated when CMake configures; the top CMakeLists.txt makes
-# every commit and checkout re-run it (so the hash follows HEAD, and "-dirty" is as of the last
-# commit, checkout or configure).
+# repository) or git is missing. Evaluated at every build (the target sheardiff_git_version
+# rewrites the generated version.cpp only when the text changes, so an unchanged hash recompiles
+# nothing): a binary built from edited sources says "-dirty" even when CMake did not re-run.
 #
-# Script mode, for tests: cmake -DSOURCE_DIR=DIR -P cmake/GitVersion.cmake   (prints the hash)
+# Script mode: cmake -DSOURCE_DIR=DIR -P cmake/GitVersion.cmake   (prints the hash; for tests)
+#              cmake -DSOURCE_DIR=DIR -DTEMPLATE=IN -DOUTPUT=OUT -DPROJECT_VERSION=V -P ...
+#              (writes OUT from IN with @PROJECT_VERSION@ and @SHEARDIFF_GIT_HASH@)
 
 # sheardiff_git_hash(SOURCE_DIR HASH_VAR GIT_DIR_VAR): HASH_VAR as above, GIT_DIR_VAR the
 # repository's (or worktree's) .git directory, empty outside a checkout.
@@ -49,5 +51,10 @@ if(CMAKE_SCRIPT_MODE_FILE STREQUAL CMAKE_CURRENT_LIST_FILE)
     message(FATAL_ERROR "usage: cmake -DSOURCE_DIR=DIR -P GitVersion.cmake")
   endif()
   sheardiff_git_hash("${SOURCE_DIR}" hash git_dir)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E echo "${hash}")
+  if(DEFINED OUTPUT)
+    set(SHEARDIFF_GIT_HASH "${hash}")
+    configure_file("${TEMPLATE}" "${OUTPUT}" @ONLY)
+  else()
+    execute_process(COMMAND ${CMAKE_COMMAND} -E echo "${hash}")
+  endif()
 endif()

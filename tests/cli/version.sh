@@ -17,7 +17,7 @@ echo "$out"
 [[ "$out" =~ ^sheardiff\ [0-9]+\.[0-9]+\.[0-9]+\ \(git\ ([0-9a-f]{4,40}(-dirty)?|unknown)\)$ ]] ||
   fail "--version printed '$out'"
 hash=$(sed 's/.*(git \(.*\))/\1/' <<< "$out")
-# Built from a checkout, it names a commit of it (HEAD when CMake last ran).
+# Built from a checkout, it names a commit of it (HEAD at the last build).
 if git -C "$src" rev-parse --show-toplevel > /dev/null 2>&1 &&
    [ "$(realpath "$(git -C "$src" rev-parse --show-toplevel)")" = "$src" ]; then
   git -C "$src" cat-file -e "${hash%-dirty}^{commit}" 2> /dev/null ||
@@ -25,7 +25,7 @@ if git -C "$src" rev-parse --show-toplevel > /dev/null 2>&1 &&
 fi
 [ "$("$bin" --version run 2>&1)" = "$out" ] || fail "--version before a subcommand"
 
-# The hash at configure time.
+# The hash GitVersion.cmake computes (at configure time and at every build).
 gv() { cmake -DSOURCE_DIR="$1" -P "$src/cmake/GitVersion.cmake" 2>&1; }
 mkdir plain
 [ "$(gv plain)" = unknown ] || fail "not a checkout: '$(gv plain)', expected unknown"
