@@ -39,9 +39,15 @@ finished=$(cd out/points && ls -d */summary.json | xargs -n1 dirname)
 rc=0; "$bin" sweep tiny.toml --out out --collect > collect.log 2>&1 || rc=$?
 [ "$rc" = 3 ] || { echo "collect of an unfinished sweep: exit $rc, expected 3"; exit 1; }
 grep -q ',done,\|,done$' out/sweep.csv
+rows() {  # a point's filled cells as key=value lines: the columns grow with later points' keys
+  /usr/bin/python3 -c 'import csv,sys
+for r in csv.DictReader(open("out/sweep.csv")):
+    if r["point"] == sys.argv[1]:
+        print("\n".join(f"{k}={v}" for k, v in sorted(r.items()) if v))' "$1"
+}
 for p in $finished; do
   sha256sum "out/points/$p/summary.json" "out/points/$p/trajectory.h5" >> before.sha
-  grep "^$p," out/sweep.csv >> before.rows
+  rows "$p" >> before.rows
   wc -c < "out/logs/$p.log" >> before.logsize
 done
 # No unfinished point is reported as done.
@@ -50,7 +56,7 @@ n_done=$(grep -c '^[^,]*,done,' out/sweep.csv || true)
 
 "$bin" sweep tiny.toml --out out > second.log 2>&1
 sha256sum -c --quiet before.sha                       # finished points untouched
-for p in $finished; do grep "^$p," out/sweep.csv; done | diff before.rows -   # same rows
+for p in $finished; do rows "$p"; done | diff before.rows -   # same rows
 for p in $finished; do wc -c < "out/logs/$p.log"; done | diff before.logsize - # not rerun
 [ "$(grep -c '^[^,]*,done,' out/sweep.csv)" = 4 ] || { echo "not all points done"; cat second.log; exit 1; }
 grep -q "before this start" second.log
