@@ -10,6 +10,7 @@
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/stress.hpp"
+#include "sheardiff/scene/registry.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {
@@ -260,8 +261,8 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
     js["started"] = nullptr;
   js["finished"] = iso8601_utc_now();
   js["scene"] = cfg.scene.type;
-  js["N"] = cfg.particles.n;
-  js["J"] = cfg.flow.j;
+  js["N"] = static_cast<std::int64_t>(p.n_mobile);
+  if (!scene_kind(cfg.scene.type).channel_flow) js["J"] = cfg.flow.j;
   js["ktilde"] = cfg.contact.ktilde;
   js["integrator"] = to_string(cfg.integrator.type);
   js["strain"] = d.strain();

@@ -21,6 +21,7 @@
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
@@ -71,6 +72,9 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
     } catch (const std::exception& e) {
       throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
     }
+  } else if (scene_kind(cfg.scene.type).channel_flow) {
+    lx = static_cast<double>(cfg.channel.wall_discs);
+    ly = cfg.channel.h_over_a * 0.5;
   } else {
     // The cell random_packing makes, without placing anything.
     double area = 0.0;
@@ -108,12 +112,13 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.max_gap_fraction = cfg.integrator.max_gap_fraction;
   lim.max_overlap_change = overlap_change_limit(cfg);
   lim.max_strain_step = cfg.integrator.max_strain_step;
-  lim.end_time = cfg.run.strain / cfg.flow.j;
+  lim.end_time = cfg.run.strain / scene.flow.clock_rate();
   if (!integrator_->implicit_springs())
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
   const double range = interaction_range_factor(cfg);
   ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);
+  if (scene.fluid) fb.set_fluid(std::move(*scene.fluid));
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
                                          lim, std::move(scene.walls));
@@ -142,6 +147,10 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
   } else {
     const double from = cfg.run.transient_strain;
     measuring = [from](const Dynamics& d) { return d.strain() > from; };
+  }
+  if (scene_kind(cfg.scene.type).channel_flow) {
+    obs.push_back(std::make_unique<ChannelObserver>(cfg));
+    return obs;
   }
   if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
     obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));

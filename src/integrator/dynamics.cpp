@@ -98,7 +98,7 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   why = StepLimit::Strain;
   double vmax = 0.0;
   for (std::size_t i = 0; i < particles_.n_mobile; ++i) {
-    const Vec3 na = v.u[i] - flow_.velocity(particles_.position[i]);
+    const Vec3 na = v.u[i] - force_balance_.fluid_velocity(flow_, v, particles_.position[i]);
     vmax = std::max(vmax, na.head<2>().squaredNorm());
   }
   vmax = std::sqrt(vmax);
@@ -138,7 +138,7 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
       na_[i].setZero();
       continue;
     }
-    na_[i] = step - flow_.velocity(particles_.position[i]).head<2>() * dt;
+    na_[i] = step - force_balance_.fluid_velocity(flow_, v, particles_.position[i]).head<2>() * dt;
     particles_.position[i] += step;
     particles_.unwrapped[i] += step;
     particles_.velocity[i] = v.u[i];
@@ -147,7 +147,7 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   // ... and are capped at its end, where their forces are next evaluated.
   force_balance_.cap_histories(particles_, box_, pairs);
   time_ += dt;
-  neighbours_.advance(na_, flow_.clock_rate() * dt);
+  neighbours_.advance(na_, force_balance_.max_shear_rate(flow_, v) * dt);
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 

@@ -19,6 +19,7 @@ namespace sheardiff {
 // Builders, one file each in src/scene.
 Scene build_simple_shear(const Config& cfg);
 Scene build_pressure_shear(const Config& cfg);
+Scene build_channel(const Config& cfg);
 
 const std::vector<SceneKind>& scene_registry() {
   static const std::vector<SceneKind> rows = {
@@ -31,6 +32,11 @@ const std::vector<SceneKind>& scene_registry() {
        "P Lx lz (the packing dilates to phi(J))",
        SHEARDIFF_SCENE_BUILDER(build_pressure_shear), /*periodic_y=*/false,
        /*measured_from_steady_state=*/true},
+      {"channel",
+       "`channel` = pressure-driven flow of monodisperse discs between two fixed rows of wall "
+       "discs at a fixed mean velocity <u> (migration; the second seed paper)",
+       SHEARDIFF_SCENE_BUILDER(build_channel), /*periodic_y=*/false,
+       /*measured_from_steady_state=*/false, /*channel_flow=*/true},
   };
   return rows;
 }

@@ -18,7 +18,14 @@ ForceBalance::ForceBalance(PairLaws laws, int dof, bool implicit_springs,
 
 void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs) {
   terms_.assign(pairs.size(), PairTerm{});
-  system_.set_pattern(p.n_mobile, pairs, p, diagonal_only_);
+  if (fluid_) {
+    const int base = system_.dof() * static_cast<int>(p.n_mobile);
+    system_.set_pattern(p.n_mobile, pairs, p, false, fluid_->unknowns(),
+                        fluid_->pattern(p, system_.dof(), base));
+    fluid_load_ = fluid_->load(system_.unknowns(), base);
+  } else {
+    system_.set_pattern(p.n_mobile, pairs, p, diagonal_only_);
+  }
 }
 
 void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs) {
@@ -159,6 +166,9 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ImposedFlo
     if (!p.external.empty()) force += p.external[i];
     system_.add_self(static_cast<int>(i), drag, force);
   }
+  if (fluid_)
+    fluid_->assemble(p, flow, system_.dof(), static_cast<int>(system_.particle_unknowns()),
+                     system_);
   // Scenes without walls get a loop with no wall branch at all.
   if (walls)
     assemble_pairs<true>(p, box, flow, pairs, dt_implicit, walls);
@@ -168,11 +178,13 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ImposedFlo
 
 bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
                                    const WallBodies* walls, Velocities& out) {
-  double v = 0.0;
+  double v = 0.0, g = 0.0;
   bool capped = false;
-  const bool ok = walls && walls->floating() ? system_.solve_with_floating_wall(
-                                                   u_, walls->load, walls->free_fall_cap, v, capped)
-                                             : system_.solve(u_);
+  const bool ok =
+      fluid_ ? system_.solve_with_multiplier(u_, fluid_load_, g)
+      : walls && walls->floating()
+          ? system_.solve_with_floating_wall(u_, walls->load, walls->free_fall_cap, v, capped)
+          : system_.solve(u_);
   out.wall_free_fall = capped;
   if (!ok) return false;
   if (check_residual_) residual_ = system_.residual(u_, v);
@@ -180,6 +192,11 @@ bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
   const int d = system_.dof();
   out.u.resize(p.size());
   out.wall_v = v;
+  if (fluid_) {
+    const auto base = static_cast<Eigen::Index>(system_.particle_unknowns());
+    out.fluid.assign(u_.data() + base, u_.data() + u_.size());
+    out.pressure_gradient = g;  // the multiplier is G itself: the reference's G0 is in g_
+  }
   for (std::size_t i = 0; i < p.size(); ++i) {
     switch (p.motion[i]) {
       case Motion::Mobile:
@@ -187,7 +204,7 @@ bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
           out.u[i] = Vec3(u_[d * i], u_[d * i + 1], u_[d * i + 2]);
         } else {
           // Without rotational unknowns only drag (and an external torque) acts on omega.
-          double w = flow.velocity(p.position[i]).z();
+          double w = fluid_velocity(flow, out, p.position[i]).z();
           if (!p.external.empty()) w += p.external[i].z() / StokesDrag::resistance(p.radius[i]).z();
           out.u[i] = Vec3(u_[d * i], u_[d * i + 1], w);
         }

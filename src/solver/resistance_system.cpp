@@ -16,8 +16,13 @@ int ResistanceSystem::index(int row, int col) const {
 }
 
 void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs,
-                                   const Particles& p, bool diagonal_only) {
+                                   const Particles& p, bool diagonal_only,
+                                   std::size_t extra_unknowns,
+                                   const std::vector<std::pair<int, int>>& extra_entries) {
   n_ = n_mobile;
+  extra_ = extra_unknowns;
+  if (extra_ > 0 && diagonal_only)
+    throw std::logic_error("ResistanceSystem: extra unknowns need the coupled pattern");
   diagonal_only_ = diagonal_only;
   factor_of_a_ = false;
   lr_.clear();
@@ -43,6 +48,7 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
     for (int r = 0; r < d; ++r)
       for (int c = 0; c < d; ++c) trip.emplace_back(d * hi + r, d * lo + c, 0.0);
   }
+  for (const auto& [r, c] : extra_entries) trip.emplace_back(r, c, 0.0);
   a_.resize(nu, nu);
   a_.setFromTriplets(trip.begin(), trip.end());
   a_.makeCompressed();
@@ -138,6 +144,7 @@ void ResistanceSystem::clear() {
   b_.setZero();
   c_ = 0.0;
   wall_rhs_ = 0.0;
+  mult_ = 0.0;
 }
 
 void ResistanceSystem::add_self(int i, const Vec3& resistance, const Vec3& force) {
@@ -182,6 +189,22 @@ void ResistanceSystem::add_pair(std::size_t k, const Pair& pr, const Mat6& m, co
     c_ += m(4, 4);
     wall_rhs_ += rhs[4];
   }
+}
+
+void ResistanceSystem::add_value(int row, int col, double v) {
+  a_.valuePtr()[index(row, col)] += v;
+}
+
+bool ResistanceSystem::solve_with_multiplier(VecX& u, const VecX& e, double& m) {
+  if (diagonal_only_ || !prepare()) return false;
+  u = apply_inverse(g_);
+  const VecX u1 = apply_inverse(e);
+  // e . (u + m u1) = 0; e . A^-1 e > 0 for e != 0.
+  m = -e.dot(u) / e.dot(u1);
+  u += m * u1;
+  mult_e_ = e;
+  mult_ = m;
+  return u.allFinite() && std::isfinite(m);
 }
 
 bool ResistanceSystem::solve(VecX& u) {
@@ -232,8 +255,10 @@ double ResistanceSystem::residual(const VecX& u, double v) const {
     for (const auto& [i, w] : t.w) au[i] += kwu * w;
   }
   au += v * b_;
-  const double gn = g_.norm();
-  return (au - g_).norm() / (gn > 0 ? gn : 1.0);
+  VecX g = g_;
+  if (mult_e_.size() == g.size()) g += mult_ * mult_e_;
+  const double gn = g.norm();
+  return (au - g).norm() / (gn > 0 ? gn : 1.0);
 }
 
 }  // namespace sheardiff

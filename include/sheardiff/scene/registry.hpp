@@ -21,6 +21,9 @@ struct SceneKind {
   // The run is measured from a detected steady state (and may stop steady.measure_strain after
   // it) rather than from run.transient_strain.
   bool measured_from_steady_state;
+  // A pressure-driven channel between fixed walls: the clock is <u> t / a, the flow has no
+  // shear rate J, and the channel's observer replaces the shear analyses.
+  bool channel_flow = false;
 };
 
 // Every scene, in the order of the configuration reference.

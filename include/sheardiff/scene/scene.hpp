@@ -8,6 +8,7 @@
 #include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/core/walls.hpp"
+#include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/scene/registry.hpp"
 
 namespace sheardiff {
@@ -18,6 +19,7 @@ struct Scene {
   Box box;
   ImposedFlow flow;
   std::optional<WallBodies> walls;
+  std::optional<FluidLayer> fluid;  // the channel's fluid, solved with the particles
 };
 
 // The scene cfg asks for, built.

@@ -6,6 +6,7 @@
 #include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/core/walls.hpp"
+#include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/interactions/pair_laws.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
@@ -36,6 +37,10 @@ struct Velocities {
   std::vector<Vec3> u;          // every particle: mobile solved, wall particles their body's motion
   double wall_v = 0.0;          // y velocity of the floating wall
   bool wall_free_fall = false;  // V was capped: the wall is not (yet) held by the packing
+  // With a fluid layer: its deviation from the reference flow at the interior nodes, and the
+  // pressure gradient G = -dp/dx that holds the mean fluid velocity (eta <u> / d^2 units).
+  std::vector<double> fluid;
+  double pressure_gradient = 0.0;
 };
 
 // Pair laws + drag -> the linear system -> velocities. One loop over the listed pairs serves
@@ -52,6 +57,25 @@ class ForceBalance {
                bool implicit_springs, const std::string& cholesky = "cholmod")
       : ForceBalance(PairLaws(lubrication, contact, std::nullopt), dof, implicit_springs,
                      cholesky) {}
+
+  // The fluid of a channel as further unknowns (interactions/fluid_layer.hpp); set before the
+  // first on_rebuild.
+  void set_fluid(FluidLayer fluid) { fluid_ = std::move(fluid); }
+  const std::optional<FluidLayer>& fluid() const { return fluid_; }
+  // The fluid's velocity (v_x, 0, omega) at x: the imposed flow plus the layer's deviation.
+  Vec3 fluid_velocity(const ImposedFlow& flow, const Velocities& v, const Vec2& x) const {
+    Vec3 u = flow.velocity(x);
+    if (fluid_) {
+      u.x() += fluid_->deviation(v.fluid, x.y());
+      u.z() -= 0.5 * fluid_->deviation_slope(v.fluid, x.y());
+    }
+    return u;
+  }
+  // The largest |dv_x/dy| of that fluid.
+  double max_shear_rate(const ImposedFlow& flow, const Velocities& v) const {
+    return fluid_ ? flow.max_shear_rate() + fluid_->max_deviation_slope(v.fluid)
+                  : flow.max_shear_rate();
+  }
 
   // The neighbour list changed: new sparsity pattern and symbolic analysis.
   void on_rebuild(const Particles& p, const std::vector<Pair>& pairs);
@@ -110,10 +134,12 @@ class ForceBalance {
                       const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls);
 
   PairLaws laws_;
+  std::optional<FluidLayer> fluid_;
   ResistanceSystem system_;
   bool diagonal_only_;
   std::vector<PairTerm> terms_;
   VecX u_;
+  VecX fluid_load_;  // the pressure gradient's generalised force on the fluid unknowns
   double residual_ = 0.0;
   bool check_residual_ = false;
 };

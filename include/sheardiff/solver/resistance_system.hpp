@@ -26,12 +26,17 @@ class ResistanceSystem {
       : dof_(dof), llt_(make_sparse_cholesky(cholesky)) {}
 
   int dof() const { return dof_; }
-  std::size_t unknowns() const { return static_cast<std::size_t>(dof_) * n_; }
+  std::size_t unknowns() const { return static_cast<std::size_t>(dof_) * n_ + extra_; }
+  // The first unknown after the particles' (extra unknowns, e.g. a fluid layer's, follow).
+  std::size_t particle_unknowns() const { return static_cast<std::size_t>(dof_) * n_; }
 
   // New pattern from the neighbour list. diagonal_only: no pair ever couples two particles
   // (no lubrication, explicit springs), so A is diagonal and no factorisation is needed.
+  // extra_unknowns follow the particles' with the entries extra_entries (row >= col, global
+  // indices) in the pattern: the blocks of a fluid layer.
   void set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs, const Particles& p,
-                   bool diagonal_only);
+                   bool diagonal_only, std::size_t extra_unknowns = 0,
+                   const std::vector<std::pair<int, int>>& extra_entries = {});
 
   void clear();
   // One-body terms: resistance on the diagonal and force on the right-hand side.
@@ -41,12 +46,20 @@ class ResistanceSystem {
   void add_pair(std::size_t k, const Pair& pr, const Mat6& m, const Vec6& f, const Vec3& known_j,
                 bool j_mobile, bool j_floating);
 
+  // One entry of the matrix (row >= col, in the pattern) and of the right-hand side.
+  void add_value(int row, int col, double v);
+  void add_rhs(int row, double v) { g_[row] += v; }
+
   // Solve. With a floating wall, its y force balance reads b.U + c V = wall_rhs - load.
   // Returns false if the factorisation failed (matrix not positive definite).
   bool solve(VecX& u);
   // capped: set when |V| hit free_fall_cap (the load is then not balanced).
   bool solve_with_floating_wall(VecX& u, double load, double free_fall_cap, double& v,
                                 bool& capped);
+
+  // Solve A u = g + m e with the constraint e . u = 0 for the multiplier m (a pressure gradient
+  // holding a flux): two back-solves on one factor.
+  bool solve_with_multiplier(VecX& u, const VecX& e, double& m);
 
   // After a solve: the matrix becomes A + k w w^T (w over the unknowns) and the right-hand side
   // g + dg, solved next time with the factor of A by the Woodbury identity (one back-solve per
@@ -59,7 +72,7 @@ class ResistanceSystem {
   std::size_t low_rank_solves() const { return low_rank_solves_; }
   std::size_t low_rank_terms() const { return low_rank_terms_; }
 
-  // Diagnostics: relative residual |A U + b V - g| / |g| of the last solve.
+  // Diagnostics: relative residual |A U + b V - g - m e| / |g + m e| of the last solve.
   double residual(const VecX& u, double v) const;
   const Eigen::SparseMatrix<double>& matrix() const { return a_; }
   const VecX& rhs() const { return g_; }
@@ -80,11 +93,13 @@ class ResistanceSystem {
   void scatter(int bi, int bj, const Mat6& m, int oi, int oj);
 
   int dof_;
-  std::size_t n_ = 0;
+  std::size_t n_ = 0, extra_ = 0;
   bool diagonal_only_ = false;
   Eigen::SparseMatrix<double> a_;  // lower triangle
   VecX g_, b_;
   double c_ = 0.0, wall_rhs_ = 0.0;
+  VecX mult_e_;  // the multiplier's direction and value of the last solve_with_multiplier
+  double mult_ = 0.0;
   std::vector<int> diag_idx_;  // dof*dof entries per particle (-1 above the diagonal)
   std::vector<int> pair_idx_;  // dof*dof entries per listed pair, -1 for non mobile-mobile
   std::vector<double> diag_;   // diagonal_only storage
