@@ -73,16 +73,13 @@ void ChannelObserver::on_step(const StepView& v) {
   lx_ = d.box().lx;
   const auto nb = static_cast<long>(bins_);
   const double yc = y_lo_ + 0.5 * height_;
-  // Discs captured by a wall (gap below kCaptureGap a to a wall disc) are left out of T.
+  // Discs captured by a wall (gap below kCaptureGap a to a wall disc) are left out of T. Such a
+  // pair is well inside the interaction range, so the neighbour list holds it.
   std::vector<char> in_t(p.n_mobile, 1);
-  if (d.walls()) {
-    for (const auto* row : {&d.walls()->bottom, &d.walls()->top})
-      for (int k : *row)
-        for (std::size_t i = 0; i < p.n_mobile; ++i) {
-          const double dx = std::remainder(p.position[i].x() - p.position[k].x(), d.box().lx);
-          const double dy = p.position[i].y() - p.position[k].y();
-          if (std::hypot(dx, dy) - p.radius[i] - p.radius[k] < kCaptureGap * a_) in_t[i] = 0;
-        }
+  for (const Pair& pr : d.neighbours().pairs()) {
+    if (p.motion[pr.j] == Motion::Mobile) continue;
+    const double gap = pair_separation(p, d.box(), pr).norm() - p.radius[pr.i] - p.radius[pr.j];
+    if (gap < kCaptureGap * a_) in_t[static_cast<std::size_t>(pr.i)] = 0;
   }
   std::vector<double> ia(bins_, 0.0), iux(bins_, 0.0), iuy(bins_, 0.0);
   double centre = 0.0, up = 0.0;

@@ -8,7 +8,6 @@ check says what it compares and why its tolerance is what it is. Run as
     /usr/bin/python3 tests/channel/channel_table_test.py [-k NAME]
 Exit 0 if every check passes, 1 otherwise (each failure printed with its numbers).
 """
-import argparse
 import json
 import math
 import pathlib
@@ -23,6 +22,7 @@ TOOL = ROOT / "tools" / "channel_table.py"
 sys.path.insert(0, str(ROOT / "tools"))
 import channel_table as ct  # noqa: E402
 import suspension_balance as sb  # noqa: E402
+from testrun import run_tests
 
 DT = 20.0        # sample interval, a/<u>
 ROUND = 1e-12    # relative round-off of the few arithmetic operations behind a mean or an error
@@ -273,25 +273,7 @@ def test_refusals():
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("-k", help="run only the tests whose name contains this")
-    a = ap.parse_args()
-    tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
-    if a.k:
-        tests = [(n, f) for n, f in tests if a.k in n]
-    failed = 0
-    for name, f in tests:
-        try:
-            f()
-            print(f"PASS {name}")
-        except AssertionError as e:
-            failed += 1
-            print(f"FAIL {name}: {e}")
-        except Exception as e:  # a crash is a failure with its message
-            failed += 1
-            print(f"ERROR {name}: {type(e).__name__}: {e}")
-    print(f"{len(tests) - failed}/{len(tests)} passed")
-    return 1 if failed else 0
+    return run_tests(globals(), __doc__)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,6 @@ Each check says what it compares and why its tolerance is what it is. Run as
     /usr/bin/python3 tests/channel/continuum_models.py [--root REPO]
 Exit 0 if every check passes, 1 otherwise (each failure printed with its numbers).
 """
-import argparse
 import math
 import pathlib
 import subprocess
@@ -18,6 +17,7 @@ from scipy.integrate import quad, simpson
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 import suspension_balance as sb  # noqa: E402
+from testrun import run_tests
 
 _cache = {}
 
@@ -236,25 +236,7 @@ def test_drawing_and_cli():
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("-k", help="run only the tests whose name contains this")
-    a = ap.parse_args()
-    tests = [(n, f) for n, f in globals().items() if n.startswith("test_") and callable(f)]
-    if a.k:
-        tests = [(n, f) for n, f in tests if a.k in n]
-    failed = 0
-    for name, f in tests:
-        try:
-            f()
-            print(f"PASS {name}")
-        except AssertionError as e:
-            failed += 1
-            print(f"FAIL {name}: {e}")
-        except Exception as e:  # a crash is a failure with its message
-            failed += 1
-            print(f"ERROR {name}: {type(e).__name__}: {e}")
-    print(f"{len(tests) - failed}/{len(tests)} passed")
-    return 1 if failed else 0
+    return run_tests(globals(), __doc__)
 
 
 if __name__ == "__main__":
