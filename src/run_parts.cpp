@@ -220,9 +220,11 @@ void RunProgress::update(const Config& cfg, const RunningState& run) {
   const double el = std::chrono::duration<double>(now - t0_).count();
   const double end = run.planned_end_strain(cfg);
   const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
-  const std::string text =
+  std::string text =
       fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
                   d.steps(), static_cast<double>(d.steps()) / el, duration_text(eta));
+  for (const auto& o : run.observers)
+    if (const std::string more = o->progress(); !more.empty()) text += "  " + more;
   if (live) {
     std::fprintf(stderr, "\r%s   ", text.c_str());
     last_print_ = now;

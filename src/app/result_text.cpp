@@ -41,6 +41,25 @@ std::string run_result_first_line(const nlohmann::json& summary, const std::stri
 
 std::string run_result_details(const nlohmann::json& summary) {
   std::string details;
+  if (summary.contains("channel_coupling")) {
+    // The channel's time is in a / <u> and its pressure scale is the flow's, not P: its own lines.
+    const std::string steady =
+        flag(summary, "channel_steady")
+            ? fmt::format("migration steady from t = {:.4g} a/<u>",
+                          num(summary, "channel_steady_time"))
+            : fmt::format("migration NOT steady: averaged from t = {:.4g} a/<u> (half the run)",
+                          num(summary, "channel_average_from"));
+    details += fmt::format("  {}\n", steady);
+    details += fmt::format(
+        "  u_c = {:.3f} <u>, phi_c = {:.3f}, u_p = {:.3f} <u>, Q_p = {:.3f}, pressure gradient "
+        "{:.3f} x Poiseuille's ({} coupling)\n",
+        num(summary, "channel_u_c"), num(summary, "channel_phi_c"),
+        num(summary, "channel_u_p_mean"), num(summary, "channel_Q_p"),
+        num(summary, "channel_dp_ratio"),
+        summary["channel_coupling"].is_string() ? summary["channel_coupling"].get<std::string>()
+                                                : std::string("?"));
+    return details;
+  }
   if (summary.contains("steady")) {
     if (!flag(summary, "steady")) {
       details +=

@@ -1,5 +1,7 @@
 #include "sheardiff/observe/channel.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -150,6 +152,17 @@ void ChannelObserver::detect_steady() {
   if (w1 <= 0.0 || w2 <= 0.0) return;
   const double m1 = c1 / w1, m2 = c2 / w2;
   if (std::abs(m2 - m1) <= tolerance_ * m2) steady_time_ = mid;
+}
+
+std::string ChannelObserver::progress() const {
+  if (closed_.empty()) return {};
+  // The migration as it goes: the last sample interval's centre distance and pressure gradient.
+  const Interval& s = closed_.back();
+  if (s.w <= 0.0) return {};
+  const std::string steady =
+      steady_time_ >= 0.0 ? fmt::format("steady from {:.4g}", steady_time_) : "not yet steady";
+  return fmt::format("centre distance {:.3f} d  G/G0 {:.3f}  {}", s.centre / s.w, s.g / s.w,
+                     steady);
 }
 
 std::vector<std::vector<double>> ChannelObserver::profiles(const Interval& s) const {

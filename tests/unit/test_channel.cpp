@@ -1,5 +1,6 @@
 // The pressure-driven channel (issue 15): the fluid solve against its analytic limits, the flux
 // held to round-off, the mirror symmetry of the dynamics, the observer's table columns.
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
+#include "sheardiff/observe/channel.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
 
@@ -178,6 +180,32 @@ TEST(Channel, MirroredStartStaysMirrored) {
     err = std::max(err, std::abs(pa.unwrapped[i].y() - (top - pb.unwrapped[i].y())));
   }
   EXPECT_LT(err, 1e-6);
+}
+
+// The progress line's status: nothing before the first sample interval closes, then the last
+// interval's centre distance and pressure-gradient ratio, the same numbers as the history's last
+// row in the summary (a mismatch would mean the user watches another quantity than the one stored).
+TEST(Channel, ProgressReportsTheLastIntervalOfTheHistory) {
+  Config c = channel_config(0.4, 14.02, 3);
+  c.channel.sample_interval = 2.0;
+  Simulation sim(c);
+  ChannelObserver obs(c);
+  EXPECT_TRUE(obs.progress().empty());
+  const Dynamics& d = sim.dynamics();
+  while (d.strain() < 4.5) {
+    sim.step();
+    const StressSample s = sim.sample();
+    obs.on_step(StepView{d, sim.integrator().velocities(), s, sim.integrator().last_dt()});
+  }
+  const std::string text = obs.progress();
+  nlohmann::json js;
+  obs.finish(d, js, nullptr);
+  const auto& h = js["channel_history"];
+  ASSERT_EQ(h["time"].size(), 3u);  // two closed intervals and the open one
+  const double c1 = h["centre_distance"][1].get<double>(), g1 = h["pressure_gradient_ratio"][1];
+  EXPECT_NE(text.find(fmt::format("centre distance {:.3f} d", c1)), std::string::npos) << text;
+  EXPECT_NE(text.find(fmt::format("G/G0 {:.3f}", g1)), std::string::npos) << text;
+  EXPECT_NE(text.find("not yet steady"), std::string::npos) << text;
 }
 
 // One-way coupling: a fixed Poiseuille background, the pressure gradient is Poiseuille's; the

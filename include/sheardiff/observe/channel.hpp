@@ -5,6 +5,7 @@
 // centreline, as a history of rows every channel.sample_interval; a detector of the steady state
 // of the migration; and at the end the steady profiles and the seed's Table 1 columns.
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "sheardiff/config.hpp"
@@ -21,6 +22,7 @@ class ChannelObserver final : public Observer {
   void on_step(const StepView& v) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
   void serialize(Archive& a) override;
+  std::string progress() const override;
 
   // The time (a / <u>) from which the migration is steady; negative while it is not.
   double steady_time() const { return steady_time_; }

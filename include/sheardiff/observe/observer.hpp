@@ -43,6 +43,8 @@ class Observer {
   virtual bool done(const Dynamics&) const { return false; }
   // The strain at which done() will turn true, once it is known (the progress line's end).
   virtual double planned_end_strain() const { return std::numeric_limits<double>::infinity(); }
+  // A few words for the progress line (how far the run's slow process has come), or nothing.
+  virtual std::string progress() const { return {}; }
   // Accumulated state, for checkpoints.
   virtual void serialize(Archive& a) { (void)a; }
   // Results into summary.json, tables into the trajectory (writer may be null).
