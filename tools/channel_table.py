@@ -17,7 +17,8 @@ Reads RUN_DIR/summary.json of `channel` runs (src/observe/channel.cpp writes the
   cover 1 - 1/e of its change, from the first history row to the steady mean. It is measured from
   the midpoint of the first sample interval, which is the time that row's average stands for,
   so an exponential approach gives its time constant. The fit t = k (H/a)^3 across cases, and
-  the exponent of a power law where the cases have more than one H/a, test the seed's
+  the exponent of a power law where the cases have more than one H/a (over all cases, and per
+  family of one phi_b and coupling, with errors from the seeds' scatter), test the seed's
   t_steady ~ (H/a)^3 a/<u> (its section 2);
 - prints the asymmetry of the steady phi profile, phi(y/H) against phi(1 - y/H). This is the rms
   of the antisymmetric part, next to what the seed scatter alone would give;
@@ -240,6 +241,33 @@ def cubic_fit(cases):
     return out
 
 
+def family_exponents(cases):
+    """The exponent p of t_e = A (H/a)^p within each family of cases sharing phi_b and coupling
+    (the seed's (H/a)^3 is a statement at fixed phi_b): {(phi_b, coupling): (p, err, widths)}
+    for families spanning two or more H/a. err propagates the cases' seed-scatter errors through
+    the weighted fit of ln t_e on ln(H/a) (None unless every case has one)."""
+    fams = {}
+    for c in cases:
+        m, e, _ = c["t_e"]
+        if math.isfinite(m) and m > 0:
+            fams.setdefault((c["phi_b"], c["coupling"]), []).append((c["h_over_a"], m, e))
+    out = {}
+    for key, pts in sorted(fams.items()):
+        if len({h for h, _, _ in pts}) < 2:
+            continue
+        x = np.log([h for h, _, _ in pts])
+        y = np.log([m for _, m, _ in pts])
+        if all(e is not None and e > 0 for _, _, e in pts):
+            w = np.array([(m / e) ** 2 for _, m, e in pts])  # 1 / var(ln t_e)
+            xb = np.dot(w, x) / w.sum()
+            sxx = np.dot(w, (x - xb) ** 2)
+            p = float(np.dot(w, (x - xb) * (y - np.dot(w, y) / w.sum())) / sxx)
+            out[key] = (p, float(1.0 / math.sqrt(sxx)), sorted({h for h, _, _ in pts}))
+        else:
+            out[key] = (float(np.polyfit(x, y, 1)[0]), None, sorted({h for h, _, _ in pts}))
+    return out
+
+
 def migration_text(cases, markdown):
     rows = [["case", "H/a", "(H/a)^3", "t_e (a/<u>)", "t_e / (H/a)^3", "steady time / (H/a)^3"]]
     for c in cases:
@@ -253,6 +281,9 @@ def migration_text(cases, markdown):
             f"fit t_e = k (H/a)^3 through the origin: k = {fit['slope']:.4g}" +
             ("" if fit["exponent"] is None else f"; power law t_e ~ (H/a)^p: p = {fit['exponent']:.2f}"
              " (seed: 3)"))
+    for (phi_b, coupling), (p, e, hs) in family_exponents(cases).items():
+        tail += (f"\nphi_b {phi_b:g} ({coupling}), H/a = {', '.join(f'{h:g}' for h in hs)}: "
+                 f"t_e ~ (H/a)^p, p = {p:.2f}" + ("" if e is None else f" +- {e:.2f}") + " (seed: 3)")
     return render(rows, markdown) + "\n\n" + tail
 
 

@@ -190,6 +190,23 @@ def test_migration_time():
         check(abs(fit["slope"] / k - 1) <= 3.7e-4, f"slope {fit['slope']} vs {k}")
         check(abs(fit["exponent"] - 3) <= 2.5e-3, f"exponent {fit['exponent']}")
         check(all(abs(x / k - 1) <= 3.7e-4 for x in fit["ratios"]), f"ratios {fit['ratios']}")
+    # Families: within each (phi_b, coupling) the weighted log fit of ln t_e on ln(H/a). Closed
+    # forms: t_e = k_f h^3 exactly in two families gives p = 3 in each to round-off (a fit across
+    # families would mix their prefactors); with relative errors r on every case the slope error
+    # is r / sqrt(sum (x - xbar)^2) for equal weights; a family of one width gives nothing.
+    def case(phi_b, h, t, e=None):
+        return dict(phi_b=phi_b, coupling="two_way", h_over_a=h, t_e=(t, e, 2 if e else 1))
+    hs = (14.02, 18.32, 30.29, 40.4)
+    cs = [case(0.4, h, 0.02 * h ** 3, 0.1 * 0.02 * h ** 3) for h in hs] + \
+         [case(0.3, h, 0.07 * h ** 3) for h in hs[:2]] + [case(0.15, 18.32, 1000.0)]
+    fam = ct.family_exponents(cs)
+    x = np.log(hs)
+    check(set(fam) == {(0.4, "two_way"), (0.3, "two_way")}, f"families {sorted(fam)}")
+    p4, e4, _ = fam[(0.4, "two_way")]
+    check(abs(p4 - 3) < 1e-12 and abs(e4 - 0.1 / math.sqrt(((x - x.mean()) ** 2).sum())) < 1e-12,
+          f"phi 0.4: p {p4} +- {e4}")
+    p3, e3, _ = fam[(0.3, "two_way")]
+    check(abs(p3 - 3) < 1e-12 and e3 is None, f"phi 0.3: p {p3} +- {e3}")
 
 
 def test_symmetry():
