@@ -195,7 +195,8 @@ json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replic
     ++done;
     for (const auto& [name, f] : fits.items())
       for (const char* q : params)
-        if (f.contains(q) && f[q].is_number()) samples[name + "." + q].push_back(f[q].get<double>());
+        if (f.contains(q) && f[q].is_number())
+          samples[name + "." + q].push_back(f[q].get<double>());
   }
   json out = json::object();
   for (const auto& [key, v] : samples) {
@@ -216,10 +217,9 @@ json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replic
 json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   if (!fs::is_directory(out_dir / "points") &&
       (spec.results.empty() || !fs::is_directory(spec.results / "points")))
-    throw ConfigError(fmt::format("{}: no sweep there (no points/ folder{})", out_dir.string(),
-                                  spec.results.empty() ? ""
-                                                       : " and no stored results in " +
-                                                             spec.results.string()));
+    throw ConfigError(fmt::format(
+        "{}: no sweep there (no points/ folder{})", out_dir.string(),
+        spec.results.empty() ? "" : " and no stored results in " + spec.results.string()));
   const auto points = expand_points(spec);
   std::vector<std::map<std::string, json>> table;
   std::set<std::string> summary_keys;
@@ -235,8 +235,8 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
     std::string status = "missing";
     // A finished run directory is stored first; a point finished elsewhere is read from the
     // store. A finished point whose config differs from the sweep's is an error, not a row.
-    const bool here = fs::exists(dir / "summary.json") &&
-                      point_state(spec, p, out_dir) == PointState::finished;
+    const bool here =
+        fs::exists(dir / "summary.json") && point_state(spec, p, out_dir) == PointState::finished;
     if (here) export_point(spec, p, out_dir);
     if (!here)
       if (const auto stored = stored_point(spec, p); !stored.empty()) dir = stored;
@@ -303,7 +303,24 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   }
   fs::create_directories(out_dir);
   write_file_atomically(out_dir / "sweep.csv", csv.str());
-  if (!spec.results.empty()) {
+  // The store's sweep.csv and fits.json stand for every point it holds: a sweep over a part of
+  // them (one J, one seed, run on another machine) stores its points but leaves those two files
+  // to a sweep that covers the whole store, instead of replacing them with fits over its part.
+  bool whole_store = true;
+  if (!spec.results.empty() && fs::is_directory(spec.results / "points")) {
+    std::set<std::string> ours;
+    for (const auto& p : points) ours.insert(p.name);
+    for (const auto& e : fs::directory_iterator(spec.results / "points"))
+      if (fs::exists(e.path() / "summary.json") && !ours.count(e.path().filename().string()))
+        whole_store = false;
+    if (!whole_store)
+      fmt::print(stderr,
+                 "sweep: {} holds points outside this sweep's axes: its sweep.csv and fits.json "
+                 "are left as they were (collect a sweep file covering all of them to refresh "
+                 "them); this sweep's are in {}\n",
+                 spec.results.string(), out_dir.string());
+  }
+  if (!spec.results.empty() && whole_store) {
     fs::create_directories(spec.results);
     write_file_atomically(spec.results / "sweep.csv", csv.str());
   }
@@ -346,8 +363,7 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
           if (const double e = num(run, (std::string(q) + "_err").c_str()); std::isfinite(e))
             e2 += e * e, ++ne;
         r[std::string(q) + "_run_err"] =
-            ne > 0 ? json(std::sqrt(e2 / ne) / std::sqrt(static_cast<double>(ne)))
-                   : json(nullptr);
+            ne > 0 ? json(std::sqrt(e2 / ne) / std::sqrt(static_cast<double>(ne))) : json(nullptr);
       }
       rows.push_back(r);
     }
@@ -367,7 +383,8 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
     fits["groups"].push_back({{"axes", group_axes[key]}, {"rows", rows}, {"fits", group_fits}});
   }
   write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
-  if (!spec.results.empty()) write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
+  if (!spec.results.empty() && whole_store)
+    write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
   return fits;
 }
 

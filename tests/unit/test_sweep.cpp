@@ -241,8 +241,7 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
   EXPECT_GT(f["D_vs_J"]["a_stderr"].get<double>(), 0.0);
   EXPECT_TRUE(f["D_vs_J"].contains("b_regression_stderr"));
   // The per-J rows hold the seeds' scatter and what the runs' own errors predict for it.
-  EXPECT_NEAR(fits["groups"][0]["rows"][0]["D_run_err"].get<double>(), 0.1 / std::sqrt(3.0),
-              1e-12);
+  EXPECT_NEAR(fits["groups"][0]["rows"][0]["D_run_err"].get<double>(), 0.1 / std::sqrt(3.0), 1e-12);
   // Every point is stored; without the run directories the stored points are finished and
   // the same fits come back from the store alone.
   for (const auto& p : points) {
@@ -254,6 +253,22 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
   EXPECT_EQ(point_state(spec, points[0], out), PointState::finished);
   const auto again = collect_sweep(spec, file.parent_path() / "elsewhere");
   EXPECT_EQ(again["groups"], fits["groups"]);
+  // A sweep over a part of the store (one J, one seed) stores into it but leaves the store's
+  // sweep.csv and fits.json, which stand for all twelve points, as they were.
+  const auto read = [](const fs::path& f) {
+    std::ifstream in(f);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string store_fits = read(spec.results / "fits.json");
+  const std::string store_csv = read(spec.results / "sweep.csv");
+  const auto part = file.parent_path() / "part.toml";
+  std::ofstream(part) << "[sweep]\nbase = \"base.toml\"\nresults = \"stored\"\n"
+                         "[sweep.axes]\n\"flow.J\" = [1e-3]\n\"run.seed\" = [2]\n";
+  const auto part_fits = collect_sweep(load_sweep(part), file.parent_path() / "part");
+  EXPECT_EQ(part_fits["finished"].get<long>(), 1);
+  EXPECT_EQ(read(spec.results / "fits.json"), store_fits);
+  EXPECT_EQ(read(spec.results / "sweep.csv"), store_csv);
+  EXPECT_TRUE(fs::exists(file.parent_path() / "part" / "fits.json"));
   // A store of another configuration is never reused.
   std::ofstream(spec.results / "points" / points[0].name / "config.toml")
       << to_toml(load_config(spec.base, points[5].overrides));
