@@ -329,7 +329,9 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   fits["sweep"] = spec.file.filename().string();
   fits["points"] = points.size();
   fits["finished"] = finished;
-  fits["seed_table1"] = seed_reference();
+  // The seed's Table 1 sits beside fits of J-sweeps only: a sweep of another scene (channel
+  // cases over seeds) has no J axis to fit and is not that paper's measurement.
+  if (!groups.empty()) fits["seed_table1"] = seed_reference();
   fits["groups"] = json::array();
   for (const auto& [key, by_j] : groups) {
     // Seeds averaged at each J (standard error of their mean where there are several).

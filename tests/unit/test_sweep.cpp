@@ -302,3 +302,24 @@ TEST(Sweep, SeedBootstrapQuotesTheUnbiasedErrorWithTwoSeeds) {
   // dv did not scatter: no error there.
   EXPECT_LT(boot["dv_vs_J"]["b"].get<double>(), 1e-12);
 }
+
+TEST(Sweep, ASweepOfSeedsOnlyStoresItsPointsWithoutJFits) {
+  // Channel cases are swept over seeds: their summaries have no J, so the collected fits.json
+  // has no groups and does not repeat the shear paper's Table 1, while every point is stored.
+  const auto file = write_files("seeds_only",
+                                "[sweep]\nbase = \"base.toml\"\nresults = \"stored\"\n"
+                                "[sweep.axes]\n\"run.seed\" = [1, 2]\n");
+  const auto spec = load_sweep(file);
+  const auto out = file.parent_path() / "out";
+  for (const auto& p : expand_points(spec)) {
+    const auto dir = point_dir(out, p);
+    fs::create_directories(dir);
+    std::ofstream(dir / "config.toml") << to_toml(load_config(spec.base, p.overrides));
+    std::ofstream(dir / "summary.json") << R"({"channel_u_c": 1.4, "steady": true})";
+  }
+  const auto fits = collect_sweep(spec, out);
+  EXPECT_EQ(fits["finished"].get<long>(), 2);
+  EXPECT_TRUE(fits["groups"].empty());
+  EXPECT_FALSE(fits.contains("seed_table1"));
+  EXPECT_TRUE(fs::exists(spec.results / "points" / "seed=2" / "summary.json"));
+}
