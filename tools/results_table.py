@@ -6,7 +6,9 @@ writes). Per group (ktilde, N, ...):
   * every J: the mean over seeds of phi, mu, D, dv, Psi with the standard error of that mean
     from the seeds' scatter (n seeds), and what the runs' own error bars predict for it;
   * the seed paper's Table 1 side by side, row by row: our a, b with errors from a bootstrap
-    over seeds, the seed's, and the verdict (difference in combined standard errors).
+    over seeds, the seed's, and the verdict (difference in combined standard errors);
+  * every J against the seed's laws evaluated there (ours over theirs);
+  * the diagnostics of the candidate causes of docs/results.md, and the cost per run.
 
     /usr/bin/python3 tools/results_table.py DIR
 """
@@ -52,6 +54,9 @@ def main():
                  f"--collect` first)")
     fits = json.loads((out / "fits.json").read_text())
     rows = list(csv.DictReader(open(out / "sweep.csv")))
+    if not fits.get("groups"):
+        sys.exit(f"{out}: fits.json has no J fits (a sweep without a flow.J axis, such as "
+                 f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
     done = [r for r in rows if r["status"].startswith("done")]
     cpu = sum(float(r["wall_seconds"]) for r in done if r.get("wall_seconds"))
@@ -100,7 +105,63 @@ def main():
                   f"a = {pm(m['a'], m.get('a_stderr'))}, b = {pm(m['b'], m.get('b_stderr'))} "
                   f"| - | - | - |")
         print()
+        against_seed_laws(g["rows"])
     causes(done)
+    cost(done)
+
+
+# The seed's laws (its Table 1 and eq. 3.3), evaluated at each of our J.
+SEED_LAWS = {"phi": lambda J: 0.81 - 0.64 * math.sqrt(J), "D": lambda J: 0.024 * J ** -0.26,
+             "dv": lambda J: 0.258 * J ** -0.25, "psi": lambda J: 0.35 * J ** 0.24}
+
+
+def against_seed_laws(rows):
+    """Per J: ours (mean over seeds +- sem), the seed's law there, and ours over the seed's."""
+    print("#### Every J against the seed's laws\n")
+    print("Ours: mean over seeds +- standard error from their scatter; seed: its Table 1 law "
+          "(phi: eq. 3.3, 0.81 - 0.64 J^1/2) at the same J; ratio: ours / seed's (phi: the "
+          "difference).\n")
+    print("| J | phi | seed | ours - seed | D | seed | ratio | dv | seed | ratio | Psi | seed | "
+          "ratio |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in sorted(rows, key=lambda r: r["J"]):
+        J = r["J"]
+        cells = []
+        for q, p in (("phi", 4), ("D", 3), ("dv", 3), ("psi", 3)):
+            x, e, ref = r.get(q), r.get(q + "_sem"), SEED_LAWS[q](J)
+            if x is None:
+                cells += ["-", fmt(ref, p), "-"]
+                continue
+            if q == "phi":
+                cells += [pm(x, e, 4), f"{ref:.4f}", f"{x - ref:+.4f}"]
+            else:
+                cells += [pm(x, e, 3), f"{ref:.3g}",
+                          f"{x / ref:.2f}" + (f" +- {e / ref:.2f}" if e is not None else "")]
+        print(f"| {J:g} | " + " | ".join(cells) + " |")
+    print()
+
+
+def cost(done):
+    """Per J: steps per strain and wall time per run, from each run's summary."""
+    def f(r, k):
+        try:
+            return float(r[k]) if r.get(k) not in (None, "") else None
+        except ValueError:
+            return None
+
+    by_j = {}
+    for r in done:
+        by_j.setdefault(f(r, "J"), []).append(r)
+    print("#### Cost per run (mean over seeds; wall time depends on what else shared the cores)\n")
+    print("| J | runs | steps per strain | ms per step | strains run | wall h per run |")
+    print("|---|---|---|---|---|---|")
+    for j in sorted(k for k in by_j if k is not None):
+        rs = by_j[j]
+        vals = [mean_sem([f(r, k) for r in rs])[0]
+                for k in ("steps_per_strain", "ms_per_step", "strain", "wall_seconds")]
+        v = [x if x is not None else float("nan") for x in vals]
+        print(f"| {j:g} | {len(rs)} | {v[0]:.0f} | {v[1]:.1f} | {v[2]:.1f} | {v[3] / 3600:.2f} |")
+    print()
 
 
 def mean_sem(v):

@@ -1,0 +1,47 @@
+#!/usr/bin/python3
+"""tools/results_table.py on a synthetic store with a known answer: one J-sweep group whose
+J = 1e-3 row lies 0.01 above the seed's phi law and at 1.5x its D law, 1x its dv and Psi laws;
+the per-J table must read those (+0.0100, 1.50, 1.00), and a store without J fits (channel cases
+over seeds) must be refused with a reason. Usage: results_table_test.py REPO WORK"""
+import csv
+import json
+import pathlib
+import subprocess
+import sys
+
+repo, work = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+work.mkdir(parents=True, exist_ok=True)
+J = 1e-3
+row = {"J": J, "runs": 3, "phi": 0.81 - 0.64 * J ** 0.5 + 0.01, "phi_sem": 0.001,
+       "D": 1.5 * 0.024 * J ** -0.26, "D_sem": 0.003, "dv": 0.258 * J ** -0.25, "dv_sem": 0.01,
+       "psi": 0.35 * J ** 0.24, "psi_sem": 0.001, "mu": 0.3, "mu_sem": 0.001}
+law = {"a": 1.0, "a_stderr": 0.1, "b": -0.25, "b_stderr": 0.01}
+names = ["D_vs_J", "dv_vs_J", "psi_vs_J", "D_vs_phic_minus_phi", "dv_vs_phic_minus_phi",
+         "psi_vs_phic_minus_phi"]
+fits = {"points": 3, "finished": 3, "seed_table1": {n: law for n in names},
+        "groups": [{"axes": {}, "rows": [row],
+                    "fits": dict({n: law for n in names},
+                                 phi_of_J={"error": "too few"}, mu_of_J={"error": "too few"})}]}
+(work / "fits.json").write_text(json.dumps(fits))
+with open(work / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=["point", "status", "J", "steps_per_strain", "ms_per_step",
+                                      "strain", "wall_seconds"])
+    w.writeheader()
+    w.writerow({"point": "J=0.001_seed=1", "status": "done", "J": J, "steps_per_strain": 7000,
+                "ms_per_step": 7.0, "strain": 33.0, "wall_seconds": 3600.0})
+tool = [sys.executable, str(repo / "tools/results_table.py"), str(work)]
+out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
+start = out.index("Every J against")
+line = next(l for l in out[start:].splitlines() if l.startswith("| 0.001 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[3] == "+0.0100", f"phi - seed's law {cells[3]!r}: want +0.0100"
+assert cells[6].startswith("1.50"), f"D ratio {cells[6]!r}: want 1.50"
+assert cells[9].startswith("1.00") and cells[12].startswith("1.00"), line
+cost = next(l for l in out[out.index("Cost per run"):].splitlines() if l.startswith("| 0.001 |"))
+assert "| 7000 | 7.0 | 33.0 | 1.00 |" in cost, cost
+# A store of channel cases: no J fits, refused with the reason.
+fits = {"points": 2, "finished": 2, "groups": []}
+(work / "fits.json").write_text(json.dumps(fits))
+r = subprocess.run(tool, capture_output=True, text=True)
+assert r.returncode != 0 and "no J fits" in r.stderr, (r.returncode, r.stderr)
+print("results_table: per-J ratios, cost table and refusal as expected")
