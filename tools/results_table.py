@@ -49,6 +49,8 @@ def main():
     if len(sys.argv) != 2:
         sys.exit(f"usage: {sys.argv[0]} DIR (a sweep folder or results/<name>)")
     out = pathlib.Path(sys.argv[1])
+    if not out.is_dir():
+        sys.exit(f"{out}: not a directory")
     if not (out / "fits.json").exists() or not (out / "sweep.csv").exists():
         sys.exit(f"{out}: no fits.json / sweep.csv (run `sheardiff sweep SWEEP.toml --out DIR "
                  f"--collect` first)")
@@ -108,6 +110,8 @@ def main():
         against_seed_laws(g["rows"])
     causes(done)
     cost(done)
+    if len(fits["groups"]) == 1:
+        subrange_fits(done)
 
 
 # The seed's laws (its Table 1 and eq. 3.3), evaluated at each of our J.
@@ -138,6 +142,75 @@ def against_seed_laws(rows):
                 cells += [pm(x, e, 3), f"{ref:.3g}",
                           f"{x / ref:.2f}" + (f" +- {e / ref:.2f}" if e is not None else "")]
         print(f"| {J:g} | " + " | ".join(cells) + " |")
+    print()
+
+
+def subrange_fits(done, replicates=2000):
+    """The exponents over parts of the J range: which J drive a fit. OLS in log-log space on the
+    seeds' means (the seed's Appendix B) and phi = phi_c - a J^b by least squares (not the
+    seed's alignment procedure: a check of where the curvature sits, not a Table 1 value);
+    errors from a bootstrap over seeds, each J's runs widened about their mean by sqrt(n/(n-1))
+    as in `sheardiff sweep --collect`."""
+    import numpy as np
+    from scipy.optimize import curve_fit
+
+    by_j = {}
+    for r in done:
+        try:
+            by_j.setdefault(float(r["J"]), []).append(
+                {q: float(r[q]) for q in ("D", "dv", "psi", "phi")})
+        except (KeyError, ValueError):
+            continue
+    js = sorted(by_j)
+    if len(js) < 4:
+        return
+    rng = np.random.default_rng(12345)
+
+    def fit(sample):
+        x = np.log([j for j, _ in sample])
+        out = {}
+        for q in ("D", "dv", "psi"):
+            out[q] = np.polyfit(x, np.log([np.mean([r[q] for r in runs]) for _, runs in sample]),
+                                1)[0]
+        J = np.array([j for j, _ in sample])
+        phi = np.array([np.mean([r["phi"] for r in runs]) for _, runs in sample])
+        try:
+            p, _ = curve_fit(lambda J, pc, a, b: pc - a * J ** b, J, phi, p0=[0.81, 0.5, 0.5],
+                             maxfev=5000)
+            out["phi_c"], out["a"], out["b"] = p
+        except RuntimeError:
+            out["phi_c"] = out["a"] = out["b"] = math.nan
+        return out
+
+    def widened(runs):
+        n = len(runs)
+        if n < 2:
+            return runs
+        w = math.sqrt(n / (n - 1))
+        m = {q: np.mean([r[q] for r in runs]) for q in runs[0]}
+        return [{q: m[q] + w * (r[q] - m[q]) for q in r} for r in runs]
+
+    print("#### Exponents over parts of the J range (seed-bootstrap errors)\n")
+    print("| J range | J values | D: b | dv: b | Psi: b | phi = phi_c - a J^b (least squares) |")
+    print("|---|---|---|---|---|---|")
+    for lo, hi in ((js[0], js[-1]), (js[0], js[-2]), (js[1], js[-2]), (js[0], js[-3])):
+        part = [(j, by_j[j]) for j in js if lo <= j <= hi]
+        if len(part) < 4:
+            continue
+        best = fit(part)
+        reps = []
+        for _ in range(replicates):
+            sample = []
+            for j, runs in part:
+                w = widened(runs)
+                sample.append((j, [w[k] for k in rng.integers(0, len(w), len(w))]))
+            reps.append(fit(sample))
+        err = {k: (float(np.nanstd([r[k] for r in reps], ddof=1))
+                   if all(len(runs) > 1 for _, runs in part) else None) for k in best}
+        print(f"| {lo:g} - {hi:g} | {len(part)} | "
+              + " | ".join(pm(best[q], err[q]) for q in ("D", "dv", "psi"))
+              + f" | phi_c = {pm(best['phi_c'], err['phi_c'], 4)}, a = {pm(best['a'], err['a'])}, "
+              f"b = {pm(best['b'], err['b'])} |")
     print()
 
 

@@ -23,12 +23,20 @@ fits = {"points": 3, "finished": 3, "seed_table1": {n: law for n in names},
                     "fits": dict({n: law for n in names},
                                  phi_of_J={"error": "too few"}, mu_of_J={"error": "too few"})}]}
 (work / "fits.json").write_text(json.dumps(fits))
+# Runs on exact laws (two seeds at +-2 %): the exponents over every part of the range are the
+# laws' own, with phi = 0.81 - 0.64 J^(1/2).
 with open(work / "sweep.csv", "w", newline="") as f:
-    w = csv.DictWriter(f, fieldnames=["point", "status", "J", "steps_per_strain", "ms_per_step",
-                                      "strain", "wall_seconds"])
+    w = csv.DictWriter(f, fieldnames=["point", "status", "J", "D", "dv", "psi", "phi",
+                                      "steps_per_strain", "ms_per_step", "strain",
+                                      "wall_seconds"])
     w.writeheader()
-    w.writerow({"point": "J=0.001_seed=1", "status": "done", "J": J, "steps_per_strain": 7000,
-                "ms_per_step": 7.0, "strain": 33.0, "wall_seconds": 3600.0})
+    for j in (1e-4, 1e-3, 1e-2, 3e-2, 1e-1):
+        for s, x in ((1, 1.02), (2, 0.98)):
+            w.writerow({"point": f"J={j:g}_seed={s}", "status": "done", "J": j,
+                        "D": x * 0.024 * j ** -0.26, "dv": x * 0.258 * j ** -0.25,
+                        "psi": x * 0.35 * j ** 0.24, "phi": 0.81 - 0.64 * j ** 0.5,
+                        "steps_per_strain": 7000, "ms_per_step": 7.0, "strain": 33.0,
+                        "wall_seconds": 3600.0})
 tool = [sys.executable, str(repo / "tools/results_table.py"), str(work)]
 out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
 start = out.index("Every J against")
@@ -38,7 +46,12 @@ assert cells[3] == "+0.0100", f"phi - seed's law {cells[3]!r}: want +0.0100"
 assert cells[6].startswith("1.50"), f"D ratio {cells[6]!r}: want 1.50"
 assert cells[9].startswith("1.00") and cells[12].startswith("1.00"), line
 cost = next(l for l in out[out.index("Cost per run"):].splitlines() if l.startswith("| 0.001 |"))
-assert "| 7000 | 7.0 | 33.0 | 1.00 |" in cost, cost
+assert "| 2 | 7000 | 7.0 | 33.0 | 1.00 |" in cost, cost
+ranges = out[out.index("Exponents over parts"):].splitlines()
+full = next(l for l in ranges if l.startswith("| 0.0001 - 0.1 |"))
+cells = [c.strip() for c in full.strip("|").split("|")]
+assert cells[2].startswith("-0.26 ") and cells[3].startswith("-0.25 "), full
+assert cells[4].startswith("0.24 ") and "b = 0.5 " in cells[5], full
 # A store of channel cases: no J fits, refused with the reason.
 fits = {"points": 2, "finished": 2, "groups": []}
 (work / "fits.json").write_text(json.dumps(fits))
