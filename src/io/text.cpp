@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <sstream>
@@ -92,6 +93,18 @@ void write_json(std::ostringstream& os, const nlohmann::json& js, int indent, in
     const bool object = js.is_object();
     if (js.empty()) {
       os << (object ? "{}" : "[]");
+      return;
+    }
+    // A list of numbers (a profile, one row of a history) on one line: one number per line
+    // made the channel's profile histories several times larger and no easier to read.
+    if (!object && std::all_of(js.begin(), js.end(),
+                               [](const nlohmann::json& e) { return e.is_number() || e.is_null(); })) {
+      os << '[';
+      for (auto it = js.begin(); it != js.end(); ++it) {
+        if (it != js.begin()) os << (indent >= 0 ? ", " : ",");
+        write_json(os, *it, indent, depth + 1);
+      }
+      os << ']';
       return;
     }
     os << (object ? '{' : '[');

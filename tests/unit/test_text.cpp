@@ -244,3 +244,13 @@ TEST(Text, ConfigReferenceTextFitsAndParsesToTheDefaults) {
 
 }  // namespace
 }  // namespace sheardiff
+
+TEST(Text, JsonTextWritesAListOfNumbersOnOneLine) {
+  using sheardiff::json_text;
+  // Profiles and history rows: one line each (a list with anything else keeps one per line).
+  const nlohmann::json js = {{"profile", {0.5, 2.0, nullptr, 3}}, {"mixed", {1, "a"}}};
+  EXPECT_EQ(json_text(js),
+            "{\n  \"mixed\": [\n    1,\n    \"a\"\n  ],\n  \"profile\": [0.5, 2.0, null, 3]\n}");
+  EXPECT_EQ(json_text(js, -1), "{\"mixed\":[1,\"a\"],\"profile\":[0.5,2.0,null,3]}");
+  EXPECT_EQ(nlohmann::json::parse(json_text(js)), js);
+}
