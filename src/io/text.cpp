@@ -97,8 +97,9 @@ void write_json(std::ostringstream& os, const nlohmann::json& js, int indent, in
     }
     // A list of numbers (a profile, one row of a history) on one line: one number per line
     // made the channel's profile histories several times larger and no easier to read.
-    if (!object && std::all_of(js.begin(), js.end(),
-                               [](const nlohmann::json& e) { return e.is_number() || e.is_null(); })) {
+    if (!object && std::all_of(js.begin(), js.end(), [](const nlohmann::json& e) {
+          return e.is_number() || e.is_null();
+        })) {
       os << '[';
       for (auto it = js.begin(); it != js.end(); ++it) {
         if (it != js.begin()) os << (indent >= 0 ? ", " : ",");
