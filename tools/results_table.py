@@ -214,17 +214,25 @@ def subrange_fits(done, replicates=2000):
     print()
 
 
-def cost(done):
-    """Per J: steps per strain and wall time per run, from each run's summary."""
-    def f(r, k):
-        try:
-            return float(r[k]) if r.get(k) not in (None, "") else None
-        except ValueError:
-            return None
+def cell(r, k):
+    """A sweep.csv cell as a float, None where empty or not a number."""
+    try:
+        return float(r[k]) if r.get(k) not in (None, "") else None
+    except ValueError:
+        return None
 
+
+def runs_by_j(done):
     by_j = {}
     for r in done:
-        by_j.setdefault(f(r, "J"), []).append(r)
+        by_j.setdefault(cell(r, "J"), []).append(r)
+    return by_j
+
+
+def cost(done):
+    """Per J: steps per strain and wall time per run, from each run's summary."""
+    f = cell
+    by_j = runs_by_j(done)
     print("#### Cost per run (mean over seeds; wall time depends on what else shared the cores)\n")
     print("| J | runs | steps per strain | ms per step | strains run | wall h per run |")
     print("|---|---|---|---|---|---|")
@@ -249,15 +257,8 @@ def mean_sem(v):
 
 def causes(done):
     """Per J (mean over seeds +- sem): the diagnostics of docs/results.md's candidate causes."""
-    def f(r, k):
-        try:
-            return float(r[k]) if r.get(k) not in (None, "") else None
-        except ValueError:
-            return None
-
-    by_j = {}
-    for r in done:
-        by_j.setdefault(f(r, "J"), []).append(r)
+    f = cell
+    by_j = runs_by_j(done)
     if not any(r.get("D_bulk") for r in done):
         return
     print("#### Diagnostics of the candidate causes (per J: mean over seeds +- sem)\n")
