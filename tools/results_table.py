@@ -231,14 +231,13 @@ def runs_by_j(done):
 
 def cost(done):
     """Per J: steps per strain and wall time per run, from each run's summary."""
-    f = cell
     by_j = runs_by_j(done)
     print("#### Cost per run (mean over seeds; wall time depends on what else shared the cores)\n")
     print("| J | runs | steps per strain | ms per step | strains run | wall h per run |")
     print("|---|---|---|---|---|---|")
     for j in sorted(k for k in by_j if k is not None):
         rs = by_j[j]
-        vals = [mean_sem([f(r, k) for r in rs])[0]
+        vals = [mean_sem([cell(r, k) for r in rs])[0]
                 for k in ("steps_per_strain", "ms_per_step", "strain", "wall_seconds")]
         v = [x if x is not None else float("nan") for x in vals]
         print(f"| {j:g} | {len(rs)} | {v[0]:.0f} | {v[1]:.1f} | {v[2]:.1f} | {v[3] / 3600:.2f} |")
@@ -257,7 +256,6 @@ def mean_sem(v):
 
 def causes(done):
     """Per J (mean over seeds +- sem): the diagnostics of docs/results.md's candidate causes."""
-    f = cell
     by_j = runs_by_j(done)
     if not any(r.get("D_bulk") for r in done):
         return
@@ -272,14 +270,14 @@ def causes(done):
         rs = by_j[j]
         cells = []
         for num_k, den_k in (("D_bulk", "D"), ("dv_bulk", "dv"), ("psi_bulk", "psi")):
-            cells.append(mean_sem([f(r, num_k) / f(r, den_k) if f(r, num_k) and f(r, den_k)
+            cells.append(mean_sem([cell(r, num_k) / cell(r, den_k) if cell(r, num_k) and cell(r, den_k)
                                    else None for r in rs]))
-        cells.append(mean_sem([f(r, "bulk_shear_rate_ratio") for r in rs]))
-        cells.append(mean_sem([f(r, "mu_top") - f(r, "mu_bottom") if f(r, "mu_top") is not None
-                               and f(r, "mu_bottom") is not None else None for r in rs]))
+        cells.append(mean_sem([cell(r, "bulk_shear_rate_ratio") for r in rs]))
+        cells.append(mean_sem([cell(r, "mu_top") - cell(r, "mu_bottom") if cell(r, "mu_top") is not None
+                               and cell(r, "mu_bottom") is not None else None for r in rs]))
         for key in ("psi", "psi_e", "psi_full", "psi_zero"):
-            cells.append(mean_sem([f(r, "D") / (f(r, "dv") ** 2 * f(r, key))
-                                   if f(r, "D") and f(r, "dv") and f(r, key) else None
+            cells.append(mean_sem([cell(r, "D") / (cell(r, "dv") ** 2 * cell(r, key))
+                                   if cell(r, "D") and cell(r, "dv") and cell(r, key) else None
                                    for r in rs]))
         print(f"| {j:g} | " + " | ".join(pm(m, e) for m, e in cells) + " |")
     print()
