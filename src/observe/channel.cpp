@@ -221,12 +221,13 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     all.push_back(now_);
     all.back().end = d.strain();
   }
-  // History profiles keep 6 significant digits: each bin of one sample interval carries a
-  // statistical error far above 1e-6, and full doubles made a long run's summary megabytes.
-  const auto list6 = [](const std::vector<double>& v) {
+  // History profiles keep 4 significant digits: one bin of one sample interval averages a few
+  // tens of disc samples (a statistical error of several per cent, far above 1e-4), and full
+  // doubles made a long run's summary megabytes (results/ keeps them).
+  const auto list4 = [](const std::vector<double>& v) {
     nlohmann::json j = nlohmann::json::array();
     for (double x : v)
-      j.push_back(std::isfinite(x) ? nlohmann::json(std::stod(fmt::format("{:.6g}", x)))
+      j.push_back(std::isfinite(x) ? nlohmann::json(std::stod(fmt::format("{:.4g}", x)))
                                    : nlohmann::json());
     return j;
   };
@@ -237,7 +238,7 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     c.push_back(s.centre / s.w);
     up.push_back(s.up / s.w / u_mean_);
     const auto pr = profiles(s);
-    for (int k = 0; k < 5; ++k) rows[k].push_back(list6(pr[k]));
+    for (int k = 0; k < 5; ++k) rows[k].push_back(list4(pr[k]));
   }
   h["time"] = t;  // a / <u>, end of each interval
   h["pressure_gradient_ratio"] = g;
