@@ -196,10 +196,18 @@ void ChannelObserver::serialize(Archive& a) {
 
 void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
   (void)writer;
-  // NaN (an empty bin) is written as null.
-  const auto list = [](const std::vector<double>& v) {
+  // NaN (an empty bin) is written as null. History profiles keep 4 significant digits
+  // (rounded): one bin of one sample interval averages a few tens of disc samples (a statistical
+  // error of several per cent, far above 1e-4), and full doubles made a long run's summary
+  // megabytes (results/ keeps them).
+  const auto list = [](const std::vector<double>& v, bool rounded = false) {
     nlohmann::json j = nlohmann::json::array();
-    for (double x : v) j.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json());
+    for (double x : v) {
+      if (!std::isfinite(x))
+        j.push_back(nlohmann::json());
+      else
+        j.push_back(rounded ? std::stod(fmt::format("{:.4g}", x)) : x);
+    }
     return j;
   };
   std::vector<double> y(bins_);
@@ -221,16 +229,6 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     all.push_back(now_);
     all.back().end = d.strain();
   }
-  // History profiles keep 4 significant digits: one bin of one sample interval averages a few
-  // tens of disc samples (a statistical error of several per cent, far above 1e-4), and full
-  // doubles made a long run's summary megabytes (results/ keeps them).
-  const auto list4 = [](const std::vector<double>& v) {
-    nlohmann::json j = nlohmann::json::array();
-    for (double x : v)
-      j.push_back(std::isfinite(x) ? nlohmann::json(std::stod(fmt::format("{:.4g}", x)))
-                                   : nlohmann::json());
-    return j;
-  };
   for (const Interval& s : all) {
     if (s.w <= 0) continue;
     t.push_back(s.end);
@@ -238,7 +236,7 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     c.push_back(s.centre / s.w);
     up.push_back(s.up / s.w / u_mean_);
     const auto pr = profiles(s);
-    for (int k = 0; k < 5; ++k) rows[k].push_back(list4(pr[k]));
+    for (int k = 0; k < 5; ++k) rows[k].push_back(list(pr[k], true));
   }
   h["time"] = t;  // a / <u>, end of each interval
   h["pressure_gradient_ratio"] = g;
