@@ -198,14 +198,16 @@ void CheckpointStore::save(RunningState& run, double elapsed_now,
 
 // ---- RunProgress ---------------------------------------------------------------------------
 
-RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds)
+RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds, const Dynamics& d)
     : dir_(dir),
       progress_(progress),
       tty_(progress && dir.terminal()),
       seconds_(seconds),
       t0_(std::chrono::steady_clock::now()),
       last_print_(t0_),
-      last_line_(t0_) {}
+      last_line_(t0_),
+      strain0_(d.strain()),
+      steps0_(d.steps()) {}
 
 double RunProgress::elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
@@ -219,10 +221,10 @@ void RunProgress::update(const Config& cfg, const RunningState& run) {
   const Dynamics& d = run.sim.dynamics();
   const double el = std::chrono::duration<double>(now - t0_).count();
   const double end = run.planned_end_strain(cfg);
-  const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain(), 1e-12);
+  const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain() - strain0_, 1e-12);
   std::string text =
       fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
-                  d.steps(), static_cast<double>(d.steps()) / el, duration_text(eta));
+                  d.steps(), static_cast<double>(d.steps() - steps0_) / el, duration_text(eta));
   for (const auto& o : run.observers)
     if (const std::string more = o->progress(); !more.empty()) text += "  " + more;
   if (live) {

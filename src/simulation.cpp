@@ -351,7 +351,7 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   if (from_checkpoint) checkpoints.load(run, std::move(payload));
   claim_directory(dir, mode, from_checkpoint, checksummed, resolved);
   TrajectoryOutput trajectory(cfg, run, dir, resolved, from_checkpoint);
-  RunProgress progress_lines(dir, progress, progress_seconds);
+  RunProgress progress_lines(dir, progress, progress_seconds, run.sim.dynamics());
 
   Simulation& sim = run.sim;
   Dynamics& d = sim.dynamics();

@@ -83,7 +83,9 @@ class CheckpointStore {
 // every `seconds` off a terminal, or in run.log alone (a terminal, --quiet).
 class RunProgress {
  public:
-  RunProgress(RunDirectory& dir, bool progress, double seconds);
+  // d: the state this process starts from (a resumed run's checkpoint), so that the rate and
+  // the ETA count only the steps taken since.
+  RunProgress(RunDirectory& dir, bool progress, double seconds, const Dynamics& d);
   // Seconds since this process started the run.
   double elapsed() const;
   void update(const Config& cfg, const RunningState& run);
@@ -95,6 +97,8 @@ class RunProgress {
   bool progress_, tty_;
   double seconds_;
   std::chrono::steady_clock::time_point t0_, last_print_, last_line_;
+  double strain0_;
+  long steps0_;
   bool shown_ = false;
 };
 

@@ -83,6 +83,20 @@ else
   echo "skipped: the terminal part (util-linux's script cannot open a pty here)"
 fi
 
+# A resumed run's rate counts the steps taken since it resumed (it used to divide every step
+# of the run by this process's time: 20x too fast a second after resuming a 2 s run).
+"$bin" run run.toml --out resumed --set run.strain=1000 --progress-every 0.2 2> r1.err &
+pid=$!; sleep 2; kill -INT $pid; wait $pid
+[ -f resumed/checkpoint.bin ] || fail "no checkpoint after SIGINT: $(cat r1.err)"
+"$bin" run run.toml --resume resumed --set run.strain=1000 --progress-every 0.1 2> r2.err &
+pid=$!; sleep 1.5; kill -INT $pid; wait $pid
+rate() { grep -oE '[0-9]+ steps/s' "$1" | awk '{print $1}' | sed -n "$2"; }
+before=$(rate r1.err '$p'); after=$(rate r2.err 1p)
+[ -n "$before" ] && [ -n "$after" ] || fail "no rates: $(cat r1.err r2.err)"
+awk -v a="$after" -v b="$before" 'BEGIN { exit !(a < 6 * b) }' ||
+  fail "resumed rate $after steps/s against $before before the stop"
+echo "ok: a resumed run's rate ($after steps/s) is its own (before the stop: $before)"
+
 # sweep: timestamps and the ETA format; --quiet.
 cat > base.toml <<'TOML'
 [scene]
