@@ -157,6 +157,7 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, bool with_counter
       a.io(run.started);
     else
       run.started = -1;
+    if (!a.loading() || !a.at_end()) d.force_balance().serialize_sticking_counts(a);
   }
 }
 
@@ -276,6 +277,16 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
   js["ms_per_step"] = 1e3 * wall_seconds / static_cast<double>(std::max<long>(d.steps(), 1));
   js["neighbour_rebuilds"] = d.neighbours().rebuilds();
   js["factorisations"] = d.force_balance().system().factorisations();
+  {
+    // Where factorisations beyond one per step come from (implicit springs at low J).
+    const auto& sc = d.force_balance().sticking_counts();
+    const double steps = static_cast<double>(std::max<long>(d.steps(), 1));
+    js["sticking_resolves_per_step"] = {
+        {"low_rank", static_cast<double>(sc.low_rank) / steps},
+        {"refactorised_budget", static_cast<double>(sc.refactorised_budget) / steps},
+        {"refactorised_wall", static_cast<double>(sc.refactorised_wall) / steps},
+        {"switched_contacts", static_cast<double>(sc.switched) / steps}};
+  }
   {
     // Which limit set the steps: where the step count comes from.
     nlohmann::json by;

@@ -118,9 +118,15 @@ bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
   // A fresh assembly reads the contacts' new state: taken when a contact with the floating wall
   // switched (its column is not a low-rank term), or when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
-  bool full = !system_.low_rank_pays(switched.size());
-  for (std::size_t k : switched) full = full || p.motion[pairs[k].j] == Motion::FloatingWall;
-  if (full) return solve(p, box, flow, pairs, dt_implicit, walls, out);
+  const bool over_budget = !system_.low_rank_pays(switched.size());
+  bool wall = false;
+  for (std::size_t k : switched) wall = wall || p.motion[pairs[k].j] == Motion::FloatingWall;
+  sticking_.switched += static_cast<long>(switched.size());
+  if (over_budget || wall) {
+    ++(over_budget ? sticking_.refactorised_budget : sticking_.refactorised_wall);
+    return solve(p, box, flow, pairs, dt_implicit, walls, out);
+  }
+  ++sticking_.low_rank;
   const int d = system_.dof();
   VecX w, dg;
   for (std::size_t k : switched) {

@@ -35,7 +35,8 @@ fs::path binary() {
 fs::path write_config(const fs::path& dir, const std::string& scene = "pressure_shear") {
   fs::create_directories(dir);
   const auto file = dir / "run.toml";
-  std::ofstream(file) << "[scene]\ntype = \"" << scene << "\"\n" << R"([particles]
+  std::ofstream(file) << "[scene]\ntype = \"" << scene << "\"\n"
+                      << R"([particles]
 N = 80
 phi_init = 0.72
 [flow]
@@ -93,7 +94,10 @@ int wait_exit(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_counters = true) {
+// with_counters: the checkpoint held the solver's work counters; with_sticking: and the sticking
+// re-solve counters (a later addition at its end).
+void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_counters = true,
+                             bool with_sticking = true) {
   const H5mdFrame fa = read_h5md_frame(a / "trajectory.h5", -1);
   const H5mdFrame fb = read_h5md_frame(b / "trajectory.h5", -1);
   EXPECT_EQ(count_h5md_frames(a / "trajectory.h5"), count_h5md_frames(b / "trajectory.h5"));
@@ -125,6 +129,8 @@ void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_cou
   for (const char* clock : {"wall_seconds", "ms_per_step", "started", "finished"})
     sa.erase(clock), sb.erase(clock);
   if (!with_counters) sa.erase("factorisations"), sb.erase("factorisations");
+  if (!with_counters || !with_sticking)
+    sa.erase("sticking_resolves_per_step"), sb.erase("sticking_resolves_per_step");
   EXPECT_EQ(sa, sb);
   EXPECT_FALSE(fs::exists(b / "checkpoint.bin")) << "a finished run keeps no checkpoint";
 }
@@ -280,8 +286,10 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
   const std::vector<char> v3 = bytes_of(root / "old" / "checkpoint.bin");
-  // Version 3 payloads end with the counters and, since issue 17, the start time.
-  const std::size_t header = 8 + 22 + 8 + 4, counters = 4 * sizeof(std::size_t) + 8;
+  // Version 3 payloads end with the counters, since issue 17 the start time, and since issue 13
+  // the sticking re-solve counters (4 longs).
+  const std::size_t header = 8 + 22 + 8 + 4,
+                    counters = 4 * sizeof(std::size_t) + 8 + 4 * sizeof(long);
   ASSERT_GT(v3.size(), header + counters);
   std::vector<char> v2(8);
   const std::uint64_t magic_length = 22;
@@ -375,13 +383,14 @@ TEST(Checkpoint, CheckpointWithOldFloatTextStillResumes) {
   Archive w = Archive::writer();
   w.io(old_text);
   std::vector<char> old_payload = w.bytes();
+  // Without the start time (8 bytes) and the sticking re-solve counters after it (4 x 8).
   old_payload.insert(old_payload.end(), payload.begin() + static_cast<long>(rest),
-                     payload.end() - 8);  // without the start time
+                     payload.end() - 40);
   const std::vector<char> file = checkpoint_file_bytes(old_payload);
   write_bytes(root / "old" / "checkpoint.bin", file);
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0)
       << text_of(root / "err.txt");
-  expect_same_final_state(root / "whole", root / "old");
+  expect_same_final_state(root / "whole", root / "old", true, false);
   nlohmann::json js;
   std::ifstream(root / "old" / "summary.json") >> js;
   EXPECT_TRUE(js["started"].is_null()) << js["started"];

@@ -74,12 +74,19 @@ void expect_same_as_full_solve(const std::string& scene, Passes passes = Passes:
     ASSERT_TRUE(
         fast.resolve_with_sticking(p, d.box(), d.flow(), pairs, switched, dt, wall, v_fast));
   }
+  const ForceBalance::StickingCounts& counts = fast.sticking_counts();
+  EXPECT_EQ(counts.switched, static_cast<long>(switched.size()));
+  EXPECT_EQ(counts.refactorised_wall, 0);
   if (passes == Passes::DefaultLimit) {
     // N = 120: a factorisation costs a handful of back-substitutions, fewer than the switched.
     EXPECT_EQ(fast.system().factorisations(), factorisations + 1);
+    EXPECT_EQ(counts.refactorised_budget, 1);
+    EXPECT_EQ(counts.low_rank, 0);
   } else {
     EXPECT_EQ(fast.system().factorisations(), factorisations);
     EXPECT_EQ(fast.system().low_rank_terms(), switched.size());
+    EXPECT_EQ(counts.refactorised_budget, 0);
+    EXPECT_EQ(counts.low_rank, passes == Passes::Two ? 2 : 1);
   }
 
   // Full path: assembled with them sticking from the start.

@@ -124,6 +124,19 @@ class ForceBalance {
   const PairLaws& laws() const { return laws_; }
   const std::optional<Lubrication>& lubrication() const { return laws_.get<Lubrication>(); }
   const FrictionalContact& contact() const { return *laws_.get<FrictionalContact>(); }
+  // What the sticking re-solves cost (resolve_with_sticking): passes solved on the old factor
+  // with low-rank terms, passes refactorised because their switched contacts would cost more
+  // back-substitutions than a factorisation, or because one touches the floating wall, and the
+  // contacts switched in all of them.
+  struct StickingCounts {
+    long low_rank = 0, refactorised_budget = 0, refactorised_wall = 0, switched = 0;
+  };
+  const StickingCounts& sticking_counts() const { return sticking_; }
+  // The work counters, for checkpoints (after the system's, as a later layout's addition).
+  void serialize_sticking_counts(Archive& a) {
+    a.io(sticking_.low_rank), a.io(sticking_.refactorised_budget),
+        a.io(sticking_.refactorised_wall), a.io(sticking_.switched);
+  }
   // |A U + b V - g| / |g| of the last solve.
   double last_residual() const { return residual_; }
   void set_check_residual(bool on) { check_residual_ = on; }
@@ -142,6 +155,7 @@ class ForceBalance {
   VecX fluid_load_;  // the pressure gradient's generalised force on the fluid unknowns
   double residual_ = 0.0;
   bool check_residual_ = false;
+  StickingCounts sticking_;
 };
 
 }  // namespace sheardiff
