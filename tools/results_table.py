@@ -11,6 +11,14 @@ writes). Per group (ktilde, N, ...):
   * the diagnostics of the candidate causes of docs/results.md, and the cost per run.
 
     /usr/bin/python3 tools/results_table.py DIR
+
+With --compare, single runs against a reference run (the checks of docs/results.md: one seed of
+another N, ktilde, mixing rule, ... against a point of the same seed): each quantity with the
+run's own error bar, the ratio to the reference and the difference in combined standard errors.
+
+    /usr/bin/python3 tools/results_table.py --compare REF_POINT POINT [POINT ...]
+
+(a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.0001_N=500_seed=1)
 """
 import csv
 import json
@@ -45,7 +53,46 @@ def law(f):
         f" +- {f['b_stderr']:.3f}" if f.get("b_stderr") is not None else "")
 
 
+# Quantities of a run compared by --compare: summary key, its error key (None: no error bar).
+COMPARED = (("phi", "phi_err"), ("mu", "mu_err"), ("D", "D_err"), ("dv", "dv_err"),
+            ("psi", "psi_err"), ("max_overlap", None), ("bulk_shear_rate_ratio", None))
+
+
+def compare(paths):
+    """Markdown table: each run's quantities against the first run's (the reference)."""
+    runs = []
+    for p in paths:
+        f = pathlib.Path(p) / "summary.json"
+        if not f.exists():
+            sys.exit(f"{p}: no summary.json (a finished run's folder)")
+        runs.append(json.loads(f.read_text()))
+    ref = runs[0]
+    print("| run | " + " | ".join(k for k, _ in COMPARED) + " |")
+    print("|---" * (len(COMPARED) + 1) + "|")
+    for p, r in zip(paths, runs):
+        cells = []
+        for k, e in COMPARED:
+            x, x0 = r.get(k), ref.get(k)
+            if x is None:
+                cells.append("-")
+                continue
+            text = pm(x, r.get(e) if e else None, 4)
+            if r is not ref and x0:
+                text += f" ({x / x0:.3f}"
+                if e and r.get(e) is not None and ref.get(e) is not None:
+                    sigma = math.hypot(r[e], ref[e])
+                    text += f", z {(x - x0) / sigma:+.1f}" if sigma > 0 else ""
+                text += ")"
+            cells.append(text)
+        print(f"| {'reference: ' if r is ref else ''}{p} | " + " | ".join(cells) + " |")
+
+
 def main():
+    if len(sys.argv) >= 2 and sys.argv[1] == "--compare":
+        if len(sys.argv) < 4:
+            sys.exit(f"usage: {sys.argv[0]} --compare REF_POINT POINT [POINT ...]")
+        compare(sys.argv[2:])
+        return
     if len(sys.argv) != 2:
         sys.exit(f"usage: {sys.argv[0]} DIR (a sweep folder or results/<name>)")
     out = pathlib.Path(sys.argv[1])

@@ -57,4 +57,18 @@ fits = {"points": 2, "finished": 2, "groups": []}
 (work / "fits.json").write_text(json.dumps(fits))
 r = subprocess.run(tool, capture_output=True, text=True)
 assert r.returncode != 0 and "no J fits" in r.stderr, (r.returncode, r.stderr)
-print("results_table: per-J ratios, cost table and refusal as expected")
+# --compare: a run 10 % above the reference in D with both error bars 0.003 (z = 0.01 /
+# sqrt(2 x 0.003^2) = +2.4), the same phi.
+for name, d in (("ref", 0.1), ("other", 0.11)):
+    (work / name).mkdir(exist_ok=True)
+    (work / name / "summary.json").write_text(json.dumps(
+        {"phi": 0.8, "phi_err": 0.001, "D": d, "D_err": 0.003, "dv": 3.0, "dv_err": 0.01}))
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--compare",
+                      str(work / "ref"), str(work / "other")],
+                     capture_output=True, text=True, check=True).stdout
+other = next(l for l in out.splitlines() if l.startswith(f"| {work / 'other'} |"))
+cells = [c.strip() for c in other.strip("|").split("|")]
+assert cells[3] == "0.11 +- 0.003 (1.100, z +2.4)", cells[3]
+assert cells[1] == "0.8 +- 0.001 (1.000, z +0.0)", cells[1]
+assert cells[6] == "-", cells[6]
+print("results_table: per-J ratios, cost table, refusal and --compare as expected")
