@@ -5,10 +5,11 @@
 // Debian's CHOLMOD wraps loops of its supernodal factorisation in OpenMP parallel regions, one
 // or more per supernode: hundreds per factorisation. sheardiff runs them with one thread
 // (OMP_THREAD_LIMIT=1, docs/performance.md "Threads"), and libgomp still opens a team for each
-// and closes it with a barrier whose wake-up is a futex system call. Measured at N = 1000
-// (bench_step, two runs sharing the 2 cores): 2.3-2.7 ms of CPU per factorisation with the
-// regions run here against 4.7-5.8 ms through libgomp, a whole step 1.65x cheaper; perf put 30 %
-// of a running J = 1e-4 sweep point in libgomp and the kernel's futex path.
+// and closes it with a barrier whose wake-up is a futex system call. perf put 30 % of a running
+// N = 1000, J = 1e-4 sweep point in libgomp and the kernel's futex path; two runs sharing the
+// 2 cores, as a sweep's workers do, take 1.65-1.82x less wall time without it
+// (bench/two_workers.sh, docs/performance.md "Issue 13"), one run alone on an idle machine
+// 1.0-1.5x less.
 //
 // This definition is found before libgomp's by the dynamic linker (the executable comes first
 // in the lookup order, and CHOLMOD's reference exports it from there). With one thread it runs
