@@ -37,12 +37,17 @@ def pm(x, e, p=3):
     return f"{x:.{p}g}" + (f" +- {e:.2g}" if e is not None else "")
 
 
+def z_score(x, e, ref, ref_e):
+    """(x - ref) in combined standard errors; inf-signed when both errors are 0."""
+    s = math.hypot(e, ref_e or 0.0)
+    return (x - ref) / s if s > 0 else math.copysign(math.inf, x - ref)
+
+
 def verdict(x, e, ref, ref_e):
     """How many combined standard errors apart; 'agrees' within 2."""
     if x is None or e is None:
         return "no error bar (one seed)"
-    s = math.hypot(e, ref_e or 0.0)
-    z = abs(x - ref) / s if s > 0 else math.inf
+    z = abs(z_score(x, e, ref, ref_e))
     return f"agrees ({z:.1f} sigma)" if z <= 2 else f"differs ({z:.1f} sigma)"
 
 
@@ -80,8 +85,8 @@ def compare(paths):
             if r is not ref and x0:
                 text += f" ({x / x0:.3f}"
                 if e and r.get(e) is not None and ref.get(e) is not None:
-                    sigma = math.hypot(r[e], ref[e])
-                    text += f", z {(x - x0) / sigma:+.1f}" if sigma > 0 else ""
+                    z = z_score(x, r[e], x0, ref[e])
+                    text += f", z {z:+.1f}" if math.isfinite(z) else ""
                 text += ")"
             cells.append(text)
         print(f"| {'reference: ' if r is ref else ''}{p} | " + " | ".join(cells) + " |")
