@@ -149,7 +149,7 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
     measuring = [from](const Dynamics& d) { return d.strain() > from; };
   }
   if (scene_kind(cfg.scene.type).channel_flow) {
-    obs.push_back(std::make_unique<ChannelObserver>(cfg));
+    obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / "channel.h5"));
     return obs;
   }
   if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
@@ -307,12 +307,14 @@ nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seco
   trajectory.close();
   // analysis.h5 is written by code that does not check its file's close: a full disk there
   // leaves a truncated file under the final name, which HDF5 then refuses to open.
-  const auto analysis = dir.file("analysis.h5");
-  if (cfg.analysis.diffusion && std::filesystem::exists(analysis) && !hdf5_file_opens(analysis)) {
-    std::filesystem::remove(analysis);
-    const std::string reason = dir.hdf5_log() ? dir.hdf5_log()->last_os_reason() : "";
-    throw IoError(fmt::format("cannot write {}: {}", analysis.string(),
-                              reason.empty() ? "the file was left incomplete" : reason));
+  for (const char* name : {"analysis.h5", "channel.h5"}) {
+    const auto file = dir.file(name);
+    if (std::filesystem::exists(file) && !hdf5_file_opens(file)) {
+      std::filesystem::remove(file);
+      const std::string reason = dir.hdf5_log() ? dir.hdf5_log()->last_os_reason() : "";
+      throw IoError(fmt::format("cannot write {}: {}", file.string(),
+                                reason.empty() ? "the file was left incomplete" : reason));
+    }
   }
   write_file_atomically(dir.file("summary.json"), json_text(js) + "\n");
   // Finished: the summary marks the run complete and the checkpoint has served its purpose.

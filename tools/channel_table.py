@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """The seed's Table 1 and figures 2, 4, 7, 8, 10 from channel runs (Nott & Brady 1994).
 
-Reads RUN_DIR/summary.json of `channel` runs (src/observe/channel.cpp writes the keys) and
+Reads RUN_DIR/summary.json and the history in RUN_DIR/channel.h5 of `channel` runs
+(src/observe/channel.cpp writes both; runs written before channel.h5 existed keep the history in
+summary.json, which is read as well) and
 
 - groups the runs by case: bulk areal fraction, H/a, coupling and number of discs. Seeds of one
   case are averaged; the error is the standard error of the seed scatter, std(ddof=1)/sqrt(n),
@@ -81,11 +83,31 @@ def load_run(path):
         scene = s.get("scene", "?") if isinstance(s, dict) else "?"
         raise RunError(f"{f}: not a channel run (scene {scene!r}, no channel_H_over_a)")
     s["path"] = path
+    if "channel_history" not in s:
+        s["channel_history"] = load_history(path)
     # The scalar is channel_u_p_mean; an older writer overwrote the profile channel_u_p with it.
     u_p = s.get("channel_u_p")
     s["u_p_mean"] = _num(s.get("channel_u_p_mean", u_p if not isinstance(u_p, list) else None))
     s["profiles"] = {k: steady_profile(s, k) for k in PROFILES}
     return s
+
+
+HISTORY_SERIES = ("time", "pressure_gradient_ratio", "centre_distance", "u_p_mean")
+
+
+def load_history(path):
+    """RUN_DIR/channel.h5's /channel_history as the dict of lists that summary.json once held
+    (profile rows as lists, nan for an empty bin); {} if the run has no such file."""
+    f = os.path.join(path, "channel.h5")
+    if not os.path.isfile(f):
+        return {}
+    import h5py
+    try:
+        with h5py.File(f, "r") as h5:
+            g = h5["channel_history"]
+            return {k: np.asarray(g[k], float).tolist() for k in HISTORY_SERIES + PROFILES}
+    except (OSError, KeyError) as e:
+        raise RunError(f"{f}: unreadable ({e})")
 
 
 def steady_profile(s, key):

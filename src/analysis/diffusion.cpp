@@ -1,11 +1,12 @@
 #include "sheardiff/analysis/diffusion.hpp"
 
 #include <fmt/format.h>
-#include <hdf5.h>
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "sheardiff/io/hdf5_tables.hpp"
 
 namespace sheardiff {
 
@@ -58,9 +59,9 @@ DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixX
         (r.frames - 1) * frame_strain, s.window_lo, s.window_hi, r.window_lo, r.window_hi));
   r.fit = fit_diffusion(r.msd, r.window_lo, r.window_hi);
   if (std::isfinite(r.fit.loglog_slope) && std::abs(r.fit.loglog_slope - 1.0) > 0.2)
-    r.warnings.push_back(fmt::format(
-        "the MSD is not diffusive in the fit window (log-log slope {:.3f}, 1 expected)",
-        r.fit.loglog_slope));
+    r.warnings.push_back(
+        fmt::format("the MSD is not diffusive in the fit window (log-log slope {:.3f}, 1 expected)",
+                    r.fit.loglog_slope));
 
   // Error bars: time blocks of s.error_block strain, at least 4 of them.
   const double measured = static_cast<double>(r.frames - 1) * frame_strain;
@@ -70,8 +71,8 @@ DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixX
         "error bars from 4 blocks of {:.3g} strain (analysis.error_block = {:g} would leave "
         "fewer than 4 in the measured window)",
         r.error_block, s.error_block));
-  const long vlag = std::min(static_cast<long>(std::ceil(s.vacf_max_lag / frame_strain)),
-                             r.frames - 1);
+  const long vlag =
+      std::min(static_cast<long>(std::ceil(s.vacf_max_lag / frame_strain)), r.frames - 1);
   const long block_frames = std::max(1L, std::lround(r.error_block / frame_strain));
   r.vel = persistence_with_errors(vy, frame_strain, vlag, block_frames);
   r.vacf = r.vel.c;
@@ -161,68 +162,39 @@ void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
   js["analysis_warnings"] = r.warnings;
 }
 
-namespace {
-
-struct H5 {
-  hid_t id;
-  herr_t (*close)(hid_t);
-  ~H5() {
-    if (id >= 0) close(id);
-  }
-};
-
-void write_vector(hid_t file, const std::string& name, const std::vector<double>& v) {
-  const hsize_t n = v.size();
-  H5 space{H5Screate_simple(1, &n, nullptr), H5Sclose};
-  H5 lcpl{H5Pcreate(H5P_LINK_CREATE), H5Pclose};
-  H5Pset_create_intermediate_group(lcpl.id, 1);
-  H5 ds{H5Dcreate2(file, name.c_str(), H5T_NATIVE_DOUBLE, space.id, lcpl.id, H5P_DEFAULT,
-                   H5P_DEFAULT),
-        H5Dclose};
-  if (ds.id < 0 || H5Dwrite(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
-    throw std::runtime_error("analysis file: cannot write " + name);
-}
-
-void write_attr(hid_t obj, const char* name, double x) {
-  H5 space{H5Screate(H5S_SCALAR), H5Sclose};
-  H5 a{H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
-  H5Awrite(a.id, H5T_NATIVE_DOUBLE, &x);
-}
-
-}  // namespace
-
 void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& file) {
   // Written under a temporary name and renamed, so a complete-looking file is complete.
   const auto tmp = file.string() + ".tmp";
   {
-    H5 f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
+    H5Id f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
     if (f.id < 0) throw std::runtime_error("cannot create " + tmp);
     write_vector(f.id, "/msd/lag", r.msd.lag);
     write_vector(f.id, "/msd/msd", r.msd.msd);
-    write_vector(f.id, "/msd/samples", std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()));
+    write_vector(f.id, "/msd/samples",
+                 std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()));
     write_vector(f.id, "/vacf/lag", r.vacf.lag);
     write_vector(f.id, "/vacf/c", r.vacf.c);
     if (r.has_bulk) {
       write_vector(f.id, "/msd/msd_bulk", r.msd_bulk.msd);
       write_vector(f.id, "/vacf/c_bulk", r.vel_bulk.c.c);
     }
-    H5 root{H5Gopen2(f.id, "/", H5P_DEFAULT), H5Gclose};
-    write_attr(root.id, "D", r.fit.d);
-    write_attr(root.id, "D_err", r.d_error.err);
-    write_attr(root.id, "D_regression_stderr", r.fit.d_stderr);
-    write_attr(root.id, "msd_intercept", r.fit.intercept);
-    write_attr(root.id, "msd_window_lo", r.window_lo);
-    write_attr(root.id, "msd_window_hi", r.window_hi);
-    write_attr(root.id, "msd_window_slope", r.fit.loglog_slope);
-    write_attr(root.id, "dv", r.dv);
-    write_attr(root.id, "psi", r.persistence.psi);
-    write_attr(root.id, "psi_e", r.persistence.psi_e);
-    write_attr(root.id, "psi_zero", r.persistence.psi_zero);
-    write_attr(root.id, "psi_full", r.persistence.psi_full);
-    write_attr(root.id, "psi_err", r.vel.psi_err);
-    write_attr(root.id, "dv_err", r.vel.dv_err);
-    write_attr(root.id, "step_length", r.step_length);
-    write_attr(root.id, "frame_strain", r.frame_strain);
+    H5Id root{H5Gopen2(f.id, "/", H5P_DEFAULT), H5Gclose};
+    write_attribute(root.id, "D", r.fit.d);
+    write_attribute(root.id, "D_err", r.d_error.err);
+    write_attribute(root.id, "D_regression_stderr", r.fit.d_stderr);
+    write_attribute(root.id, "msd_intercept", r.fit.intercept);
+    write_attribute(root.id, "msd_window_lo", r.window_lo);
+    write_attribute(root.id, "msd_window_hi", r.window_hi);
+    write_attribute(root.id, "msd_window_slope", r.fit.loglog_slope);
+    write_attribute(root.id, "dv", r.dv);
+    write_attribute(root.id, "psi", r.persistence.psi);
+    write_attribute(root.id, "psi_e", r.persistence.psi_e);
+    write_attribute(root.id, "psi_zero", r.persistence.psi_zero);
+    write_attribute(root.id, "psi_full", r.persistence.psi_full);
+    write_attribute(root.id, "psi_err", r.vel.psi_err);
+    write_attribute(root.id, "dv_err", r.vel.dv_err);
+    write_attribute(root.id, "step_length", r.step_length);
+    write_attribute(root.id, "frame_strain", r.frame_strain);
   }
   std::filesystem::rename(tmp, file);
 }

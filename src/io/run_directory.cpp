@@ -93,8 +93,8 @@ std::string this_command_line() {
 
 const std::vector<std::string>& run_file_names() {
   static const std::vector<std::string> names = {
-      "config.toml",    "trajectory.h5",  "analysis.h5", "summary.json",
-      "checkpoint.bin", "diagnostic.txt", kLog};
+      "config.toml",  "trajectory.h5",  "analysis.h5",    "channel.h5",
+      "summary.json", "checkpoint.bin", "diagnostic.txt", kLog};
   return names;
 }
 

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include "sheardiff/interactions/fluid_layer.hpp"
+#include "sheardiff/io/hdf5_tables.hpp"
 #include "sheardiff/observe/profiles.hpp"
 
 namespace sheardiff {
@@ -15,14 +18,15 @@ constexpr double kCaptureGap =
     0.01;  // in a: the seed leaves discs this close to a wall disc out of T
 }
 
-ChannelObserver::ChannelObserver(const Config& cfg)
+ChannelObserver::ChannelObserver(const Config& cfg, std::filesystem::path history_file)
     : phi_b_(cfg.channel.phi),
       u_mean_(cfg.channel.mean_velocity),
       y_lo_(0.5),  // the bottom wall row's surface (scene/channel.cpp)
       height_(cfg.channel.h_over_a * 0.5),
       interval_(cfg.channel.sample_interval),
       window_(cfg.channel.steady_window),
-      tolerance_(cfg.channel.steady_tolerance) {
+      tolerance_(cfg.channel.steady_tolerance),
+      history_file_(std::move(history_file)) {
   // Bins of (about) a/2 tiling the channel exactly, as the seed's figures.
   bins_ = static_cast<std::size_t>(std::max(1L, std::lround(height_ / (0.5 * a_))));
   bin_ = height_ / static_cast<double>(bins_);
@@ -194,56 +198,72 @@ void ChannelObserver::serialize(Archive& a) {
   for (Interval& s : closed_) s.serialize(a);
 }
 
-void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
-  (void)writer;
-  // NaN (an empty bin) is written as null. History profiles keep 4 significant digits
-  // (rounded): one bin of one sample interval averages a few tens of disc samples (a statistical
-  // error of several per cent, far above 1e-4), and full doubles made a long run's summary
-  // megabytes (results/ keeps them).
-  const auto list = [](const std::vector<double>& v, bool rounded = false) {
-    nlohmann::json j = nlohmann::json::array();
-    for (double x : v) {
-      if (!std::isfinite(x))
-        j.push_back(nlohmann::json());
-      else
-        j.push_back(rounded ? std::stod(fmt::format("{:.4g}", x)) : x);
-    }
-    return j;
-  };
-  std::vector<double> y(bins_);
-  for (std::size_t b = 0; b < bins_; ++b) y[b] = (static_cast<double>(b) + 0.5) * bin_ / height_;
-  js["channel_y"] = y;  // bin centres over H, from the bottom wall row's surface
-  js["channel_H_over_a"] = height_ / a_;
-  js["channel_phi_bulk"] = phi_b_;
-  js["channel_mean_velocity"] = u_mean_;
-  js["channel_coupling"] = d.force_balance().fluid() ? "two_way" : "one_way";
-  js["channel_pressure_gradient_poiseuille"] = g0_;
-  // The history.
-  nlohmann::json h;
-  std::vector<double> t, g, c, up;
-  const char* names[5] = {"phi", "u_p", "u_f", "T_time", "T_instant"};
-  std::vector<nlohmann::json> rows(5, nlohmann::json::array());
-  // The open interval too, ending now (a run's length need not be a whole number of them).
+std::vector<ChannelObserver::Interval> ChannelObserver::intervals(const Dynamics& d) const {
   std::vector<Interval> all = closed_;
   if (now_.w > 0.0) {
     all.push_back(now_);
     all.back().end = d.strain();
   }
-  for (const Interval& s : all) {
+  return all;
+}
+
+ChannelHistory ChannelObserver::history(const Dynamics& d) const {
+  ChannelHistory h;
+  for (std::size_t b = 0; b < bins_; ++b)
+    h.y.push_back((static_cast<double>(b) + 0.5) * bin_ / height_);
+  for (const Interval& s : intervals(d)) {
     if (s.w <= 0) continue;
-    t.push_back(s.end);
-    g.push_back(s.g / s.w);
-    c.push_back(s.centre / s.w);
-    up.push_back(s.up / s.w / u_mean_);
-    const auto pr = profiles(s);
-    for (int k = 0; k < 5; ++k) rows[k].push_back(list(pr[k], true));
+    h.time.push_back(s.end);
+    h.pressure_gradient_ratio.push_back(s.g / s.w);
+    h.centre_distance.push_back(s.centre / s.w);
+    h.u_p_mean.push_back(s.up / s.w / u_mean_);
+    auto pr = profiles(s);
+    for (int k = 0; k < 5; ++k) h.profiles[k].push_back(std::move(pr[k]));
   }
-  h["time"] = t;  // a / <u>, end of each interval
-  h["pressure_gradient_ratio"] = g;
-  h["centre_distance"] = c;  // d
-  h["u_p_mean"] = up;
-  for (int k = 0; k < 5; ++k) h[names[k]] = rows[k];
-  js["channel_history"] = h;
+  return h;
+}
+
+void write_channel_history(const ChannelHistory& h, const std::filesystem::path& file) {
+  // Written under a temporary name and renamed, so a complete-looking file is complete.
+  const auto tmp = file.string() + ".tmp";
+  {
+    H5Id f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
+    if (f.id < 0) throw std::runtime_error("cannot create " + tmp);
+    write_vector(f.id, "/channel_history/y", h.y);
+    write_vector(f.id, "/channel_history/time", h.time);
+    write_vector(f.id, "/channel_history/pressure_gradient_ratio", h.pressure_gradient_ratio);
+    write_vector(f.id, "/channel_history/centre_distance", h.centre_distance);
+    write_vector(f.id, "/channel_history/u_p_mean", h.u_p_mean);
+    // float32: one bin of one interval averages a few tens of disc samples, a statistical
+    // error of several per cent, far above float32's 1e-7; as text the profiles made a long
+    // run's summary megabytes.
+    for (int k = 0; k < 5; ++k)
+      write_compressed_table(f.id, std::string("/channel_history/") + h.profile_names[k],
+                             h.profiles[k], h.y.size());
+  }
+  std::filesystem::rename(tmp, file);
+}
+
+void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
+  (void)writer;
+  // NaN (an empty bin) is written as null.
+  const auto list = [](const std::vector<double>& v) {
+    nlohmann::json j = nlohmann::json::array();
+    for (double x : v) j.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json());
+    return j;
+  };
+  const ChannelHistory h = history(d);
+  js["channel_y"] = h.y;
+  js["channel_H_over_a"] = height_ / a_;
+  js["channel_phi_bulk"] = phi_b_;
+  js["channel_mean_velocity"] = u_mean_;
+  js["channel_coupling"] = d.force_balance().fluid() ? "two_way" : "one_way";
+  js["channel_pressure_gradient_poiseuille"] = g0_;
+  if (!history_file_.empty()) {
+    write_channel_history(h, history_file_);
+    js["channel_history_file"] = history_file_.filename().string();
+  }
+  const std::vector<Interval> all = intervals(d);
 
   // The steady state: from the detected time, else the second half of the run (flagged).
   const bool steady = steady_time_ >= 0.0;
@@ -258,7 +278,8 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
   if (sum.w <= 0.0) return;
   js["channel_average_from"] = from;
   const auto pr = profiles(sum);
-  for (int k = 0; k < 5; ++k) js[std::string("channel_") + names[k]] = list(pr[k]);
+  for (int k = 0; k < 5; ++k)
+    js[std::string("channel_") + ChannelHistory::profile_names[k]] = list(pr[k]);
   // The seed's Table 1 columns: centre values (the two bins at the centreline), the width
   // average of the particle velocity profile (bins holding discs), the particle flux
   // mean(phi u_p) / phi_b and the pressure gradient over Poiseuille's.

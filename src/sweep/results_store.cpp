@@ -53,7 +53,7 @@ bool export_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& ou
   fs::create_directories(dst);
   bool copied = false;
   // config.toml first and summary.json last: a stored point counts once its summary is there.
-  for (const char* name : {"config.toml", "analysis.h5", "summary.json"}) {
+  for (const char* name : {"config.toml", "analysis.h5", "channel.h5", "summary.json"}) {
     if (!fs::exists(src / name)) continue;
     const std::string bytes = read_all(src / name);
     if (fs::exists(dst / name) && read_all(dst / name) == bytes) continue;

@@ -289,6 +289,39 @@ def test_refusals():
                   f"{d}: exit {p.returncode}, stderr {p.stderr!r}, stdout {p.stdout[:80]!r}")
 
 
+def test_history_in_channel_h5():
+    """A run of the old layout (history in summary.json) moved by tools/channel_history_to_h5.py:
+    the summary loses the history and names channel.h5; load_run then gives the same history
+    (float64 series exactly, profiles to float32's 1e-7 relative, empty bins still nan), the
+    same steady profiles and the same migration time. A second pass leaves the pair alone."""
+    import channel_history_to_h5 as mv
+    with tempfile.TemporaryDirectory() as tmp:
+        r = make_runs(tmp)
+        before = ct.load_run(r["b3_1"])
+        check(mv.main([r["b3_1"]]) == 0, "converter failed")
+        s = json.loads((pathlib.Path(r["b3_1"]) / "summary.json").read_text())
+        check("channel_history" not in s and s.get("channel_history_file") == "channel.h5",
+              f"summary keys after the move: {sorted(s)[:5]}...")
+        after = ct.load_run(r["b3_1"])
+        hb, ha = before["channel_history"], after["channel_history"]
+        for k in ct.HISTORY_SERIES:
+            check(ha[k] == list(hb[k]), f"series {k} changed")
+        for k in ct.PROFILES:
+            a = np.array(ha[k], float)
+            b = np.array([[math.nan if x is None else x for x in row] for row in hb[k]], float)
+            check(a.shape == b.shape and np.array_equal(np.isnan(a), np.isnan(b))
+                  and np.allclose(a, b, rtol=1e-7, atol=0, equal_nan=True), f"profile {k}")
+        for k in ct.PROFILES:
+            check(np.allclose(after["profiles"][k], before["profiles"][k], rtol=1e-7, equal_nan=True),
+                  f"steady {k}")
+        t_b = ct.migration_time(hb["time"], hb["centre_distance"], before["channel_centre_distance"])
+        t_a = ct.migration_time(ha["time"], ha["centre_distance"], after["channel_centre_distance"])
+        check(t_a == t_b, f"migration time {t_a} against {t_b}")
+        h5 = (pathlib.Path(r["b3_1"]) / "channel.h5").read_bytes()
+        check(mv.main([r["b3_1"]]) == 0 and (pathlib.Path(r["b3_1"]) / "channel.h5").read_bytes() == h5,
+              "second pass touched the files")
+
+
 def main():
     return run_tests(globals(), __doc__)
 

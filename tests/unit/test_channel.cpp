@@ -9,6 +9,7 @@
 
 #include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
+#include "sheardiff/io/hdf5_tables.hpp"
 #include "sheardiff/observe/channel.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
@@ -198,11 +199,9 @@ TEST(Channel, ProgressReportsTheLastIntervalOfTheHistory) {
     obs.on_step(StepView{d, sim.integrator().velocities(), s, sim.integrator().last_dt()});
   }
   const std::string text = obs.progress();
-  nlohmann::json js;
-  obs.finish(d, js, nullptr);
-  const auto& h = js["channel_history"];
-  ASSERT_EQ(h["time"].size(), 3u);  // two closed intervals and the open one
-  const double c1 = h["centre_distance"][1].get<double>(), g1 = h["pressure_gradient_ratio"][1];
+  const ChannelHistory h = obs.history(d);
+  ASSERT_EQ(h.time.size(), 3u);  // two closed intervals and the open one
+  const double c1 = h.centre_distance[1], g1 = h.pressure_gradient_ratio[1];
   EXPECT_NE(text.find(fmt::format("centre distance {:.3f} d", c1)), std::string::npos) << text;
   EXPECT_NE(text.find(fmt::format("G/G0 {:.3f}", g1)), std::string::npos) << text;
   EXPECT_NE(text.find("not yet steady"), std::string::npos) << text;
@@ -222,6 +221,15 @@ TEST(Channel, SummaryColumnsOneAndTwoWay) {
                      (std::string("sheardiff_test_channel_") + coupling);
     std::filesystem::remove_all(dir);
     const nlohmann::json js = run_to_directory(c, dir, false);
+    // The history is in DIR/channel.h5 (rows every 5 a/<u>: the last interval closes at the
+    // run's end, or is still open), not in the summary.
+    EXPECT_FALSE(js.contains("channel_history"));
+    EXPECT_EQ(js["channel_history_file"], "channel.h5");
+    const auto time = read_dataset(dir / "channel.h5", "/channel_history/time");
+    EXPECT_GE(time.size(), 3u);
+    EXPECT_NEAR(time.back(), js["strain"].get<double>(), 1e-9);
+    const auto phi_rows = read_dataset(dir / "channel.h5", "/channel_history/phi");
+    EXPECT_EQ(phi_rows.size(), time.size() * js["channel_y"].size());
     std::filesystem::remove_all(dir);
     const bool two_way = std::string(coupling) == "two_way";
     EXPECT_EQ(js["channel_coupling"], coupling);
@@ -230,8 +238,6 @@ TEST(Channel, SummaryColumnsOneAndTwoWay) {
     } else {
       EXPECT_GT(js["channel_dp_ratio"].get<double>(), 1.0);
     }
-    // Rows every 5 a/<u> (the last interval closes at the run's end, or is still open).
-    EXPECT_GE(js["channel_history"]["time"].size(), 3u);
     // phi integrates to phi_b: the bins tile the channel; a disc resting in a dip of a wall
     // row reaches below its surface by up to (2 - sqrt 3) a, an area left out of the bins:
     // allow 2 %.
@@ -272,6 +278,33 @@ TEST(Channel, RefusesPolydisperseAndShearAnalyses) {
       ConfigError);
   EXPECT_NO_THROW(
       parse_config(base + "[particles]\nsize_ratio = 1.0\n[run]\nstrain = 100\n", "t.toml"));
+}
+
+// channel.h5 round trip: float64 series exact, the profiles to float32 precision, an empty bin
+// (NaN) stays NaN; a ragged table is refused rather than written shifted.
+TEST(Channel, HistoryFileRoundTrip) {
+  ChannelHistory h;
+  h.y = {0.25, 0.75};
+  h.time = {5.0, 10.0};
+  h.pressure_gradient_ratio = {2.0, 2.1};
+  h.centre_distance = {4.0, 4.25};
+  h.u_p_mean = {0.97, 0.98};
+  for (auto& rows : h.profiles) rows = {{0.123456789, NAN}, {1.0 / 3.0, 2.0}};
+  const auto file = std::filesystem::temp_directory_path() / "sheardiff_test_channel_history.h5";
+  write_channel_history(h, file);
+  EXPECT_EQ(read_dataset(file, "/channel_history/centre_distance"), h.centre_distance);
+  for (const char* name : ChannelHistory::profile_names) {
+    const auto v = read_dataset(file, std::string("/channel_history/") + name);
+    ASSERT_EQ(v.size(), 4u) << name;
+    EXPECT_NEAR(v[0], 0.123456789, 1e-7) << name;
+    EXPECT_TRUE(std::isnan(v[1])) << name;
+    EXPECT_NEAR(v[2], 1.0 / 3.0, 1e-7) << name;
+  }
+  EXPECT_THROW(read_dataset(file, "/channel_history/missing"), std::runtime_error);
+  std::filesystem::remove(file);
+  h.profiles[2][1].pop_back();
+  EXPECT_THROW(write_channel_history(h, file), std::logic_error);
+  std::filesystem::remove(file.string() + ".tmp");
 }
 
 }  // namespace

@@ -21,8 +21,8 @@ struct SweepSpec {
   int jobs = 2;
   std::string backend = "local";
   // Optional: where finished points' small results persist (summary.json, config.toml,
-  // analysis.h5; no trajectories), e.g. results/<sweep name> in the repository. Points found
-  // there count as finished, and --collect works from it alone (docs/sweeps.md).
+  // analysis.h5 or channel.h5; no trajectories), e.g. results/<sweep name> in the repository.
+  // Points found there count as finished, and --collect works from it alone (docs/sweeps.md).
   std::filesystem::path results;
   struct Slurm {
     int throttle = 0;  // at most this many array tasks at once; 0 = no limit
@@ -79,9 +79,9 @@ std::pair<std::string, std::string> submit_slurm(const SweepSpec& spec,
                                                  const std::filesystem::path& out_dir,
                                                  const std::filesystem::path& exe);
 
-// Copies a finished point's small results (summary.json, config.toml, analysis.h5) into
-// spec.results/points/<name>/ (each file atomically; nothing if spec.results is empty or the
-// point is not finished in out_dir). Returns whether it copied.
+// Copies a finished point's small results (summary.json, config.toml, analysis.h5 or
+// channel.h5) into spec.results/points/<name>/ (each file atomically; nothing if spec.results
+// is empty or the point is not finished in out_dir). Returns whether it copied.
 bool export_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
 // The stored results of a point: spec.results/points/<name>/ if it holds a summary.json of
 // this point's config, else an empty path.
