@@ -89,6 +89,41 @@ void cholmod_supernodal(benchmark::State& state) {
 }
 BENCHMARK(cholmod_supernodal<false>)->Name("cholmod_supernodal_amd")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
 BENCHMARK(cholmod_supernodal<true>)->Name("cholmod_supernodal_tuned")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+// Back-substitutions of the low-rank sticking re-solve (ResistanceSystem::apply_inverse): k
+// columns, each the slip mode of one contact (6 non-zeros), solved one by one (as sheardiff
+// does) or as one k-column block on the tuned supernodal factor. Compare time per column with
+// cholmod_supernodal_tuned's factorisation: that ratio bounds the budget of low_rank_pays
+// (docs/performance.md, "Block columns for the sticking re-solve": measured not to pay in runs).
+template <bool Block>
+void cholmod_low_rank_columns(benchmark::State& state) {
+  const Problem& p = problem(static_cast<int>(state.range(0)));
+  const auto k = static_cast<Eigen::Index>(state.range(1));
+  Supernodal solver;
+  sheardiff::tune_cholmod(solver.cholmod());
+  solver.analyzePattern(p.lower);
+  solver.factorize(p.lower);
+  const Eigen::Index n = p.lower.rows();
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(n, k);
+  for (Eigen::Index c = 0; c < k; ++c)
+    for (Eigen::Index r = 0; r < 6; ++r) w((c * 97 + r * (n / 7)) % n, c) = 1.0 / (1.0 + r);
+  Eigen::MatrixXd z(n, k);
+  for (auto _ : state) {
+    if (Block) {
+      z = solver.solve(w);
+    } else {
+      for (Eigen::Index c = 0; c < k; ++c) z.col(c) = solver.solve(Eigen::VectorXd(w.col(c)));
+    }
+    benchmark::DoNotOptimize(z.data());
+  }
+  state.counters["us_per_column"] = benchmark::Counter(
+      static_cast<double>(k) * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
+                                         benchmark::Counter::kInvert);
+}
+BENCHMARK(cholmod_low_rank_columns<false>)->Name("cholmod_columns_one_by_one")
+    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_low_rank_columns<true>)->Name("cholmod_columns_block")
+    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})->Unit(benchmark::kMillisecond);
+
 using CholSimplicial = Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 BENCHMARK(factorise<CholSimplicial>)->Name("cholmod_simplicial_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
 #endif
