@@ -68,8 +68,18 @@ void factorise(benchmark::State& state) {
 
 using LLT = Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 using LDLT = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-BENCHMARK(factorise<LLT>)->Name("eigen_simplicial_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
-BENCHMARK(factorise<LDLT>)->Name("eigen_simplicial_ldlt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(factorise<LLT>)
+    ->Name("eigen_simplicial_llt")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(factorise<LDLT>)
+    ->Name("eigen_simplicial_ldlt")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
 #ifdef SHEARDIFF_HAVE_CHOLMOD
 using Supernodal = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 
@@ -85,10 +95,38 @@ void cholmod_supernodal(benchmark::State& state) {
   const double flops = solver.cholmod().fl;
   state.counters["nnz_L"] = solver.cholmod().lnz;
   state.counters["Mflop"] = flops / 1e6;
-  state.counters["GFlop/s"] = benchmark::Counter(flops / 1e9, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["GFlop/s"] =
+      benchmark::Counter(flops / 1e9, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(cholmod_supernodal<false>)->Name("cholmod_supernodal_amd")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
-BENCHMARK(cholmod_supernodal<true>)->Name("cholmod_supernodal_tuned")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_supernodal<false>)
+    ->Name("cholmod_supernodal_amd")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_supernodal<true>)
+    ->Name("cholmod_supernodal_tuned")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
+// sheardiff's CHOLMOD path (make_sparse_cholesky("cholmod"): the matrix scattered into
+// tril(P A P^T) and factorised with the natural ordering) against cholmod_supernodal_tuned
+// above (CHOLMOD permuting it with two symmetric transposes per factorisation).
+void sheardiff_cholmod(benchmark::State& state) {
+  const Problem& p = problem(static_cast<int>(state.range(0)));
+  auto solver = sheardiff::make_sparse_cholesky("cholmod");
+  solver->analyze(p.lower);
+  Eigen::VectorXd x;
+  for (auto _ : state) {
+    solver->factorize(p.lower);
+    x = solver->solve(p.rhs);
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.counters["rel_residual"] = (p.full * x - p.rhs).norm() / p.rhs.norm();
+}
+BENCHMARK(sheardiff_cholmod)->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+
 // Back-substitutions of the low-rank sticking re-solve (ResistanceSystem::apply_inverse): k
 // columns, each the slip mode of one contact (6 non-zeros), solved one by one (as sheardiff
 // does) or as one k-column block on the tuned supernodal factor. Compare time per column with
@@ -116,16 +154,25 @@ void cholmod_low_rank_columns(benchmark::State& state) {
     benchmark::DoNotOptimize(z.data());
   }
   state.counters["us_per_column"] = benchmark::Counter(
-      static_cast<double>(k) * 1e-6, benchmark::Counter::kIsIterationInvariantRate |
-                                         benchmark::Counter::kInvert);
+      static_cast<double>(k) * 1e-6,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(cholmod_low_rank_columns<false>)->Name("cholmod_columns_one_by_one")
-    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})->Unit(benchmark::kMillisecond);
-BENCHMARK(cholmod_low_rank_columns<true>)->Name("cholmod_columns_block")
-    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_low_rank_columns<false>)
+    ->Name("cholmod_columns_one_by_one")
+    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_low_rank_columns<true>)
+    ->Name("cholmod_columns_block")
+    ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})
+    ->Unit(benchmark::kMillisecond);
 
 using CholSimplicial = Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-BENCHMARK(factorise<CholSimplicial>)->Name("cholmod_simplicial_llt")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(factorise<CholSimplicial>)
+    ->Name("cholmod_simplicial_llt")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
 #endif
 
 // Conjugate gradient warm-started from the exact solution perturbed by 1% (what a previous
@@ -133,13 +180,14 @@ BENCHMARK(factorise<CholSimplicial>)->Name("cholmod_simplicial_llt")->Arg(250)->
 template <class Preconditioner>
 void conjugate_gradient(benchmark::State& state) {
   const Problem& p = problem(static_cast<int>(state.range(0)));
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Preconditioner> cg;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper, Preconditioner>
+      cg;
   cg.setTolerance(1e-10);
   cg.compute(p.full);
   LLT exact(p.lower);
   const Eigen::VectorXd x_exact = exact.solve(p.rhs);
-  const Eigen::VectorXd guess = x_exact + 0.01 * x_exact.cwiseAbs().maxCoeff() *
-                                              Eigen::VectorXd::Random(x_exact.size());
+  const Eigen::VectorXd guess =
+      x_exact + 0.01 * x_exact.cwiseAbs().maxCoeff() * Eigen::VectorXd::Random(x_exact.size());
   Eigen::VectorXd x;
   for (auto _ : state) {
     cg.compute(p.full);
@@ -149,8 +197,18 @@ void conjugate_gradient(benchmark::State& state) {
   state.counters["iterations"] = static_cast<double>(cg.iterations());
   state.counters["rel_residual"] = (p.full * x - p.rhs).norm() / p.rhs.norm();
 }
-BENCHMARK(conjugate_gradient<Eigen::DiagonalPreconditioner<double>>)->Name("cg_jacobi_warm")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
-BENCHMARK(conjugate_gradient<Eigen::IncompleteCholesky<double>>)->Name("cg_ichol_warm")->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
+BENCHMARK(conjugate_gradient<Eigen::DiagonalPreconditioner<double>>)
+    ->Name("cg_jacobi_warm")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(conjugate_gradient<Eigen::IncompleteCholesky<double>>)
+    ->Name("cg_ichol_warm")
+    ->Arg(250)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
