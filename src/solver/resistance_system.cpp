@@ -101,11 +101,18 @@ bool ResistanceSystem::prepare() {
   if (factor_of_a_) return true;
   ++factorisations_;
   factor_of_a_ = llt_->factorize(a_);
+  a_inverse_b_.resize(0);
   return factor_of_a_;
 }
 
-VecX ResistanceSystem::apply_inverse(const VecX& x) {
-  VecX y = llt_->solve(x);
+VecX ResistanceSystem::apply_inverse(const VecX& x, VecX* a_inverse_x) {
+  VecX y;
+  if (a_inverse_x != nullptr && a_inverse_x->size() == x.size()) {
+    y = *a_inverse_x;
+  } else {
+    y = llt_->solve(x);
+    if (a_inverse_x != nullptr) *a_inverse_x = y;
+  }
   if (lr_.empty()) return y;
   // Woodbury: (A + W K W^T)^-1 = A^-1 - Z (K^-1 + W^T Z)^-1 Z^T, Z = A^-1 W. The columns of Z
   // of earlier passes are kept: a pass costs one back-substitution per new term.
@@ -133,6 +140,7 @@ VecX ResistanceSystem::apply_inverse(const VecX& x) {
 
 void ResistanceSystem::clear() {
   factor_of_a_ = false;
+  a_inverse_b_.resize(0);
   lr_.clear();
   lr_z_cols_ = 0;
   lr_ready_ = false;
@@ -227,7 +235,9 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
   } else {
     if (!prepare()) return false;
     u = apply_inverse(g_);
-    u1 = apply_inverse(b_);
+    // The wall column is the same in every sticking pass on one factor (a switched contact
+    // with the wall refactorises): its A^-1 b is solved once per factorisation.
+    u1 = apply_inverse(b_, &a_inverse_b_);
   }
   // Schur complement of the bordered system [[A, b], [b^T, c]].
   const double schur = c_ - b_.dot(u1);

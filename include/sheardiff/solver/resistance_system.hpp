@@ -105,7 +105,9 @@ class ResistanceSystem {
   std::vector<double> diag_;   // diagonal_only storage
   // Factorise A unless the factor is already A's (low-rank terms pending), then A'^-1 x.
   bool prepare();
-  VecX apply_inverse(const VecX& x);
+  // a_inverse_x: A^-1 x of the current factor if already solved (non-empty), else filled.
+  VecX apply_inverse(const VecX& x, VecX* a_inverse_x = nullptr);
+  VecX a_inverse_b_;  // A^-1 b of the current factor; empty until solved
 
   std::unique_ptr<SparseCholesky> llt_;
   std::size_t factorisations_ = 0, analyses_ = 0, low_rank_solves_ = 0, low_rank_terms_ = 0;
