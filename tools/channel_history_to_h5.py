@@ -28,8 +28,8 @@ import sys
 import h5py
 import numpy as np
 
-SERIES = ("time", "pressure_gradient_ratio", "centre_distance", "u_p_mean")
-PROFILES = ("phi", "u_p", "u_f", "T_time", "T_instant")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from channel_table import HISTORY_SERIES as SERIES, PROFILES  # noqa: E402
 
 
 def write_history(h, y, file):

@@ -208,10 +208,14 @@ std::vector<ChannelObserver::Interval> ChannelObserver::intervals(const Dynamics
 }
 
 ChannelHistory ChannelObserver::history(const Dynamics& d) const {
+  return history_of(intervals(d));
+}
+
+ChannelHistory ChannelObserver::history_of(const std::vector<Interval>& all) const {
   ChannelHistory h;
   for (std::size_t b = 0; b < bins_; ++b)
     h.y.push_back((static_cast<double>(b) + 0.5) * bin_ / height_);
-  for (const Interval& s : intervals(d)) {
+  for (const Interval& s : all) {
     if (s.w <= 0) continue;
     h.time.push_back(s.end);
     h.pressure_gradient_ratio.push_back(s.g / s.w);
@@ -252,7 +256,8 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     for (double x : v) j.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json());
     return j;
   };
-  const ChannelHistory h = history(d);
+  const std::vector<Interval> all = intervals(d);
+  const ChannelHistory h = history_of(all);
   js["channel_y"] = h.y;
   js["channel_H_over_a"] = height_ / a_;
   js["channel_phi_bulk"] = phi_b_;
@@ -263,7 +268,6 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
     write_channel_history(h, history_file_);
     js["channel_history_file"] = history_file_.filename().string();
   }
-  const std::vector<Interval> all = intervals(d);
 
   // The steady state: from the detected time, else the second half of the run (flagged).
   const bool steady = steady_time_ >= 0.0;

@@ -140,7 +140,6 @@ VecX ResistanceSystem::apply_inverse(const VecX& x, VecX* a_inverse_x) {
 
 void ResistanceSystem::clear() {
   factor_of_a_ = false;
-  a_inverse_b_.resize(0);
   lr_.clear();
   lr_z_cols_ = 0;
   lr_ready_ = false;

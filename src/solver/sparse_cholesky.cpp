@@ -53,6 +53,9 @@ class Cholmod final : public SparseCholesky {
   Cholmod() {
     if (openblas_set_num_threads) openblas_set_num_threads(1);
     tune_cholmod(ordering_.cholmod());
+    // Only its P is used: a simplicial analysis orders and postorders the same way and skips
+    // the supernodal symbolic factor that natural_ computes anyway.
+    ordering_.cholmod().supernodal = CHOLMOD_SIMPLICIAL;
     tune_cholmod(natural_.cholmod());
     natural_.cholmod().nmethods = 1;
     natural_.cholmod().method[0].ordering = CHOLMOD_NATURAL;

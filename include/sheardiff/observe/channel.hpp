@@ -64,6 +64,7 @@ class ChannelObserver final : public Observer {
   // The closed intervals and the open one, ending now (a run's length need not be a whole
   // number of them).
   std::vector<Interval> intervals(const Dynamics& d) const;
+  ChannelHistory history_of(const std::vector<Interval>& all) const;
   void close_interval(double now);
   void detect_steady();
 
