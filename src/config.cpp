@@ -214,6 +214,11 @@ const std::vector<KeySpec>& schema() {
                      &C::Integrator::max_overlap_change, 0.0, 0.1, false, "d",
                      "Adaptive dt: largest change of any contact overlap per step; 0 = "
                      "min(max_displacement, 10 d / ktilde), ten typical overlaps P d / kn."));
+    s.push_back(real("integrator.max_entry_overlap", &C::integrator,
+                     &C::Integrator::max_entry_overlap, 0.0, 0.1, false, "d",
+                     "Adaptive dt: largest overlap a closing pair may reach in the step it "
+                     "touches; 0 = off (the gap limit alone allows max_gap_fraction x delta "
+                     "a_mean)."));
     s.push_back(real("integrator.max_strain_step", &C::integrator, &C::Integrator::max_strain_step,
                      0.0, 0.1, true, "1 (strain)", "Adaptive dt: upper bound gammadot dt."));
     s.push_back(real("integrator.explicit_safety", &C::integrator, &C::Integrator::explicit_safety,

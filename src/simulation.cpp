@@ -111,6 +111,7 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.max_displacement = cfg.integrator.max_displacement;
   lim.max_gap_fraction = cfg.integrator.max_gap_fraction;
   lim.max_overlap_change = overlap_change_limit(cfg);
+  lim.max_entry_overlap = cfg.integrator.max_entry_overlap;
   lim.max_strain_step = cfg.integrator.max_strain_step;
   lim.end_time = cfg.run.strain / scene.flow.clock_rate();
   if (!integrator_->implicit_springs())

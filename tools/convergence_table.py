@@ -17,6 +17,12 @@ is itself uncertain by 35-70 % and can be small by chance. Units of the differen
           table reports it and z, and the verdict needs both.
 
     /usr/bin/python3 tools/convergence_table.py DIR [--axis KEY] [--reference VALUE]
+    /usr/bin/python3 tools/convergence_table.py DIR --reference-from REF_DIR --reference VALUE \
+        [--reference-axis KEY]
+
+With --reference-from, the reference is the points of another sweep (same protocol and seeds)
+whose --reference-axis (default: its one axis besides run.seed) equals VALUE, e.g. the md = 3e-4 d
+points of a step-size sweep against a sweep of a new step policy.
 """
 import argparse
 import csv
@@ -44,6 +50,18 @@ def g(x, p=3):
     return "-" if x is None else f"{x:.{p}g}"
 
 
+def finished_rows(folder):
+    """The finished points of a sweep folder or store (its sweep.csv), and its axes."""
+    path = pathlib.Path(folder) / "sweep.csv"
+    if not path.exists():
+        sys.exit(f"{path}: missing (run `sheardiff sweep SWEEP.toml --out DIR --collect` first)")
+    rows = [r for r in csv.DictReader(open(path)) if r["status"].startswith("done")]
+    if not rows:
+        sys.exit(f"{path}: no finished points yet")
+    return rows, [k[len("axis."):] for k in rows[0]
+                  if k.startswith("axis.") and k != "axis.run.seed"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("dir")
@@ -51,23 +69,37 @@ def main():
                     "run.seed)")
     ap.add_argument("--reference", type=float, help="the converged value of the axis (default: "
                     "the smallest)")
+    ap.add_argument("--reference-from", metavar="REF_DIR", help="take the reference points "
+                    "from this sweep folder or store instead of DIR")
+    ap.add_argument("--reference-axis", help="REF_DIR's axis that --reference names (default: "
+                    "its one axis that is not run.seed)")
     a = ap.parse_args()
-    path = pathlib.Path(a.dir) / "sweep.csv"
-    if not path.exists():
-        sys.exit(f"{path}: missing (run `sheardiff sweep SWEEP.toml --out DIR --collect` first)")
-    rows = [r for r in csv.DictReader(open(path)) if r["status"].startswith("done")]
-    if not rows:
-        sys.exit(f"{path}: no finished points yet")
-    axes = [k[len("axis."):] for k in rows[0] if k.startswith("axis.") and k != "axis.run.seed"]
+    rows, axes = finished_rows(a.dir)
     axis = a.axis or (axes[0] if len(axes) == 1 else None)
     if axis is None or f"axis.{axis}" not in rows[0]:
-        sys.exit(f"{path}: give --axis, one of {axes}")
+        sys.exit(f"{a.dir}: give --axis, one of {axes}")
     groups = {}
     for r in rows:
         groups.setdefault(float(r[f"axis.{axis}"]), []).append(r)
-    ref_value = a.reference if a.reference is not None else min(groups)
-    if ref_value not in groups:
-        sys.exit(f"--reference {ref_value}: no finished point has {axis} = {ref_value}")
+    if a.reference_from:
+        if a.reference is None:
+            sys.exit("--reference-from needs --reference VALUE (of --reference-axis)")
+        ref_rows, ref_axes = finished_rows(a.reference_from)
+        ref_axis = a.reference_axis or (ref_axes[0] if len(ref_axes) == 1 else None)
+        if ref_axis is None or f"axis.{ref_axis}" not in ref_rows[0]:
+            sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes}")
+        ref_value = a.reference
+        ref_group = [r for r in ref_rows if float(r[f"axis.{ref_axis}"]) == ref_value]
+        if not ref_group:
+            sys.exit(f"--reference {ref_value}: no finished point of {a.reference_from} has "
+                     f"{ref_axis} = {ref_value}")
+        ref_label = f"reference: {ref_axis} = {ref_value:g} of {a.reference_from}"
+    else:
+        ref_value = a.reference if a.reference is not None else min(groups)
+        if ref_value not in groups:
+            sys.exit(f"--reference {ref_value}: no finished point has {axis} = {ref_value}")
+        ref_group = groups[ref_value]
+        ref_label = f"reference {ref_value:g}"
 
     def stats(rs, q):
         m, e = mean_sem([float(r[q]) for r in rs if r.get(q) not in (None, "")])
@@ -77,31 +109,33 @@ def main():
             e = own if e is None else max(e, own)
         return m, e
 
-    ref = {q: stats(groups[ref_value], q) for q, _ in QUANTITIES}
-    print(f"{sum(len(v) for v in groups.values())} finished points; axis {axis}, reference "
-          f"{ref_value:g}. Cells: mean over seeds +- standard error of the mean (the larger of the "
+    ref = {q: stats(ref_group, q) for q, _ in QUANTITIES}
+    print(f"{sum(len(v) for v in groups.values())} finished points; axis {axis}, {ref_label}. "
+          f"Cells: mean over seeds +- standard error of the mean (the larger of the "
           f"seeds' scatter and the runs' own error bars); "
           f"(z, r) = difference from the reference in combined standard errors and in the "
           f"reference's standard error.\n")
     print("| " + axis + " | seeds | " + " | ".join(h for _, h in QUANTITIES)
           + " | steps / strain | run s / strain |")
     print("|---" * (len(QUANTITIES) + 4) + "|")
-    for v in sorted(groups, reverse=True):
-        rs = groups[v]
+    table = [(f"{v:g}", rs, not a.reference_from and v == ref_value)
+             for v, rs in sorted(groups.items(), reverse=True)]
+    if a.reference_from:
+        table.append(("reference", ref_group, True))
+    for label, rs, is_ref in table:
         cells = []
         for q, _ in QUANTITIES:
             m, e = stats(rs, q)
             cell = g(m, 4) + (f" +- {e:.2g}" if e is not None else "")
             rm, re = ref[q]
-            if v != ref_value and m is not None and rm is not None and re:
+            if not is_ref and m is not None and rm is not None and re:
                 comb = math.hypot(e or 0.0, re)
                 cell += f" ({(m - rm) / comb:+.1f}, {(m - rm) / re:+.1f})"
             cells.append(cell)
         steps, _ = stats(rs, "steps_per_strain")
         secs = mean_sem([float(r["wall_seconds"]) / float(r["strain"]) for r in rs
                          if r.get("wall_seconds") and r.get("strain")])[0]
-        print(f"| {v:g} | {len(rs)} | " + " | ".join(cells) + f" | {g(steps)} | {g(secs)} |")
-
+        print(f"| {label} | {len(rs)} | " + " | ".join(cells) + f" | {g(steps)} | {g(secs)} |")
 
 if __name__ == "__main__":
     main()

@@ -56,6 +56,7 @@ struct Config {
     double max_displacement = 1e-3;
     double max_gap_fraction = 0.5;
     double max_overlap_change = 0.0;  // 0 = overlap_change_limit(): from the contact stiffness
+    double max_entry_overlap = 0.0;   // 0 = off: only the gap limit bounds a closing pair
     double max_strain_step = 1e-2;
     double explicit_safety = 0.5;
   } integrator;

@@ -117,8 +117,10 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
       if (opening != 0.0)
         take(limits_.max_overlap_change / std::abs(opening), dt, StepLimit::Overlap);
     } else if (opening < 0.0) {
-      const double room = (t.g.r - t.g.s) + 0.5 * delta * t.g.s;
-      take(limits_.max_gap_fraction * room / -opening, dt, StepLimit::Gap);
+      const double gap = t.g.r - t.g.s;
+      take(limits_.max_gap_fraction * (gap + 0.5 * delta * t.g.s) / -opening, dt, StepLimit::Gap);
+      if (limits_.max_entry_overlap > 0.0)
+        take((std::max(gap, 0.0) + limits_.max_entry_overlap) / -opening, dt, StepLimit::Gap);
     }
   }
   if (limits_.explicit_dt > 0.0) take(limits_.explicit_dt, dt, StepLimit::Explicit);

@@ -2,8 +2,9 @@
 """tools/convergence_table.py on a synthetic sweep.csv with a known answer: three values of a
 setting, four seeds each; the coarsest carries a bias of exactly 4 reference standard errors in
 dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
-seed values); runs' own error bars larger than their scatter set the mean's error; and an
-unknown axis must be refused. Usage: convergence_table_test.py REPO WORK"""
+seed values); runs' own error bars larger than their scatter set the mean's error; an unknown
+axis must be refused; and a reference taken from another sweep (--reference-from) must give
+the same cells as the same points in one sweep. Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
 import subprocess
@@ -51,4 +52,32 @@ cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[5].endswith("+- 0.5"), f"psi cell {cells[5]!r}: want the runs' own error 1/sqrt(4)"
 bad = subprocess.run(tool + ["--axis", "flow.J"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--axis" in bad.stderr, bad.stderr
+# The md = 3e-4 points as the reference of another sweep (a new setting, same seeds): its biased
+# value must read r = +4.0 in dv against them, as above, and the reference gets its own row.
+other = work / "other"
+other.mkdir(exist_ok=True)
+cols2 = [c if c != "axis.integrator.max_displacement" else "axis.integrator.max_entry_overlap"
+         for c in cols]
+new_rows = []
+for r in rows:
+    if r["axis.integrator.max_displacement"] == 3e-3:
+        q = {k if k != "axis.integrator.max_displacement" else "axis.integrator.max_entry_overlap":
+             v for k, v in r.items()}
+        q["axis.integrator.max_entry_overlap"] = 3e-4
+        new_rows.append(q)
+with open(other / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=cols2)
+    w.writeheader()
+    w.writerows(new_rows)
+out = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(other),
+                      "--reference-from", str(work), "--reference", "3e-4"],
+                     capture_output=True, text=True, check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[4].endswith(", +4.0)"), f"dv cell {cells[4]!r}: want r = +4.0 against the other sweep"
+assert any(l.startswith("| reference | 4 |") for l in out.splitlines()), out
+bad = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(other),
+                      "--reference-from", str(work), "--reference", "5e-4"],
+                     capture_output=True, text=True)
+assert bad.returncode != 0 and "--reference 0.0005" in bad.stderr, bad.stderr
 print("convergence_table: ok")

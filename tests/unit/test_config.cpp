@@ -40,6 +40,7 @@ void expect_same_config(Config a, Config b) {
   EXPECT_EQ(a.integrator.max_displacement, b.integrator.max_displacement);
   EXPECT_EQ(a.integrator.max_gap_fraction, b.integrator.max_gap_fraction);
   EXPECT_EQ(a.integrator.max_overlap_change, b.integrator.max_overlap_change);
+  EXPECT_EQ(a.integrator.max_entry_overlap, b.integrator.max_entry_overlap);
   EXPECT_EQ(a.integrator.max_strain_step, b.integrator.max_strain_step);
   EXPECT_EQ(a.integrator.explicit_safety, b.integrator.explicit_safety);
   EXPECT_EQ(a.neighbour.skin, b.neighbour.skin);
@@ -171,6 +172,7 @@ TEST(Config, ToTomlRoundTrips) {
   c.integrator.max_displacement = 2e-3;
   c.integrator.max_gap_fraction = 0.25;
   c.integrator.max_overlap_change = 5e-4;
+  c.integrator.max_entry_overlap = 7e-4;
   c.integrator.max_strain_step = 3e-3;
   c.integrator.explicit_safety = 0.7;
   c.neighbour.skin = 0.45;

@@ -226,6 +226,31 @@ TEST(TwoBodyContact, SteadyOverlapIsForceOverStiffness) {
   }
 }
 
+// The adaptive step of two equal discs closing head on at speed w = 1 from a gap g = 0.001 d (no
+// contact yet): the gap limit allows a closing of max_gap_fraction (g + delta s / 2) = 0.003 d,
+// i.e. an overlap of 0.002 d after the step; integrator.max_entry_overlap = 2e-4 d caps the
+// closing at g + 2e-4 = 0.0012 d. The displacement limit (0.1 d / 0.5) stays out of the way.
+TEST(TwoBodyContact, EntryOverlapLimitsTheStepThatCloses) {
+  for (double entry : {0.0, 2e-4}) {
+    SCOPED_TRACE("max_entry_overlap=" + std::to_string(entry));
+    Config cfg = two_body_config(IntegratorType::Implicit, 0.0, 1e4);
+    cfg.integrator.max_displacement = 0.1;
+    cfg.integrator.max_entry_overlap = entry;
+    Simulation sim(cfg, two_body_scene(0.5, 0.5, 0.002));
+    Dynamics& d = sim.dynamics();
+    d.begin_step();
+    Velocities v;
+    ASSERT_TRUE(d.solve(0.0, v));  // evaluates the pair's terms at this geometry
+    ASSERT_FALSE(d.neighbours().pairs().at(0).history.touching);
+    v.u[0] = Vec3(0.5, 0.0, 0.0);
+    v.u[1] = Vec3(-0.5, 0.0, 0.0);
+    StepLimit why = StepLimit::Fixed;
+    const double dt = d.dt_limit(v, &why);
+    EXPECT_EQ(why, StepLimit::Gap);
+    EXPECT_NEAR(dt, entry > 0.0 ? 0.001 + entry : 0.5 * (0.001 + 0.5 * kDelta), 1e-12);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 3. Coulomb friction.
 //
