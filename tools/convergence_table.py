@@ -18,7 +18,7 @@ is itself uncertain by 35-70 % and can be small by chance. Units of the differen
 
     /usr/bin/python3 tools/convergence_table.py DIR [--axis KEY] [--reference VALUE]
     /usr/bin/python3 tools/convergence_table.py DIR --reference-from REF_DIR --reference VALUE \
-        [--reference-axis KEY]
+        [--reference-axis KEY] [--axis KEY] [--only KEY=VALUE ...]
 
 With --reference-from, the reference is the points of another sweep (same protocol and seeds)
 whose --reference-axis (default: its one axis besides run.seed) equals VALUE, e.g. the md = 3e-4 d
@@ -73,8 +73,18 @@ def main():
                     "from this sweep folder or store instead of DIR")
     ap.add_argument("--reference-axis", help="REF_DIR's axis that --reference names (default: "
                     "its one axis that is not run.seed)")
+    ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
+                    help="keep only the points whose axis KEY has this value (repeatable), e.g. "
+                    "one J of a sweep over several J against that J's reference")
     a = ap.parse_args()
     rows, axes = finished_rows(a.dir)
+    for cond in a.only:
+        key, eq, value = cond.partition("=")
+        if not eq or f"axis.{key}" not in rows[0]:
+            sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of {axes + ['run.seed']}")
+        rows = [r for r in rows if float(r[f"axis.{key}"]) == float(value)]
+        if not rows:
+            sys.exit(f"--only {cond}: no finished point has {key} = {value}")
     axis = a.axis or (axes[0] if len(axes) == 1 else None)
     if axis is None or f"axis.{axis}" not in rows[0]:
         sys.exit(f"{a.dir}: give --axis, one of {axes}")

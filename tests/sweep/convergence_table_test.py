@@ -80,4 +80,10 @@ bad = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), 
                       "--reference-from", str(work), "--reference", "5e-4"],
                      capture_output=True, text=True)
 assert bad.returncode != 0 and "--reference 0.0005" in bad.stderr, bad.stderr
+# --only keeps one value of the axis.
+out = subprocess.run(tool + ["--only", "integrator.max_displacement=1e-3"], capture_output=True,
+                     text=True, check=True).stdout
+assert [l[:9] for l in out.splitlines() if l.startswith("| 0.")] == ["| 0.001 |"], out
+bad = subprocess.run(tool + ["--only", "flow.J=1e-3"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--only flow.J=1e-3" in bad.stderr, bad.stderr
 print("convergence_table: ok")
