@@ -80,9 +80,14 @@ def main():
     rows, axes = finished_rows(a.dir)
     for cond in a.only:
         key, eq, value = cond.partition("=")
-        if not eq or f"axis.{key}" not in rows[0]:
-            sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of {axes + ['run.seed']}")
-        rows = [r for r in rows if float(r[f"axis.{key}"]) == float(value)]
+        try:
+            wanted = float(value)
+        except ValueError:
+            wanted = None
+        if not eq or f"axis.{key}" not in rows[0] or wanted is None:
+            sys.exit(f"--only {cond}: give KEY=VALUE, a number for an axis KEY, one of "
+                     f"{axes + ['run.seed']}")
+        rows = [r for r in rows if float(r[f"axis.{key}"]) == wanted]
         if not rows:
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")
     axis = a.axis or (axes[0] if len(axes) == 1 else None)

@@ -86,4 +86,7 @@ out = subprocess.run(tool + ["--only", "integrator.max_displacement=1e-3"], capt
 assert [l[:9] for l in out.splitlines() if l.startswith("| 0.")] == ["| 0.001 |"], out
 bad = subprocess.run(tool + ["--only", "flow.J=1e-3"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--only flow.J=1e-3" in bad.stderr, bad.stderr
+bad = subprocess.run(tool + ["--only", "integrator.max_displacement=abc"], capture_output=True,
+                     text=True)
+assert bad.returncode != 0 and "a number" in bad.stderr, bad.stderr
 print("convergence_table: ok")
