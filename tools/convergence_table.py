@@ -62,6 +62,11 @@ def finished_rows(folder):
                   if k.startswith("axis.") and k != "axis.run.seed"]
 
 
+def the_axis(given, axes):
+    """The axis a table is about: the one named, else the sweep's one axis besides run.seed."""
+    return given or (axes[0] if len(axes) == 1 else None)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("dir")
@@ -90,7 +95,7 @@ def main():
         rows = [r for r in rows if float(r[f"axis.{key}"]) == wanted]
         if not rows:
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")
-    axis = a.axis or (axes[0] if len(axes) == 1 else None)
+    axis = the_axis(a.axis, axes)
     if axis is None or f"axis.{axis}" not in rows[0]:
         sys.exit(f"{a.dir}: give --axis, one of {axes}")
     groups = {}
@@ -100,7 +105,7 @@ def main():
         if a.reference is None:
             sys.exit("--reference-from needs --reference VALUE (of --reference-axis)")
         ref_rows, ref_axes = finished_rows(a.reference_from)
-        ref_axis = a.reference_axis or (ref_axes[0] if len(ref_axes) == 1 else None)
+        ref_axis = the_axis(a.reference_axis, ref_axes)
         if ref_axis is None or f"axis.{ref_axis}" not in ref_rows[0]:
             sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes}")
         ref_value = a.reference
