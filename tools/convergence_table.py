@@ -22,7 +22,8 @@ is itself uncertain by 35-70 % and can be small by chance. Units of the differen
 
 With --reference-from, the reference is the points of another sweep (same protocol and seeds)
 whose --reference-axis (default: its one axis besides run.seed) equals VALUE, e.g. the md = 3e-4 d
-points of a step-size sweep against a sweep of a new step policy.
+points of a step-size sweep against a sweep of a new step policy. An --only KEY that REF_DIR
+also has as an axis filters REF_DIR's points too (one ktilde of a sweep over several).
 """
 import argparse
 import csv
@@ -83,6 +84,7 @@ def main():
                     "one J of a sweep over several J against that J's reference")
     a = ap.parse_args()
     rows, axes = finished_rows(a.dir)
+    only = []
     for cond in a.only:
         key, eq, value = cond.partition("=")
         try:
@@ -95,6 +97,7 @@ def main():
         rows = [r for r in rows if float(r[f"axis.{key}"]) == wanted]
         if not rows:
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")
+        only.append((cond, key, wanted))
     axis = the_axis(a.axis, axes)
     if axis is None or f"axis.{axis}" not in rows[0]:
         sys.exit(f"{a.dir}: give --axis, one of {axes}")
@@ -109,6 +112,12 @@ def main():
         if ref_axis is None or f"axis.{ref_axis}" not in ref_rows[0]:
             sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes}")
         ref_value = a.reference
+        # An --only axis that REF_DIR also varies (e.g. ktilde) selects its reference points too.
+        for cond, key, wanted in only:
+            if f"axis.{key}" in ref_rows[0]:
+                ref_rows = [r for r in ref_rows if float(r[f"axis.{key}"]) == wanted]
+                if not ref_rows:
+                    sys.exit(f"--only {cond}: no finished point of {a.reference_from} has it")
         ref_group = [r for r in ref_rows if float(r[f"axis.{ref_axis}"]) == ref_value]
         if not ref_group:
             sys.exit(f"--reference {ref_value}: no finished point of {a.reference_from} has "

@@ -89,4 +89,31 @@ assert bad.returncode != 0 and "--only flow.J=1e-3" in bad.stderr, bad.stderr
 bad = subprocess.run(tool + ["--only", "integrator.max_displacement=abc"], capture_output=True,
                      text=True)
 assert bad.returncode != 0 and "a number" in bad.stderr, bad.stderr
+# --only on an axis both sweeps vary (ktilde) keeps that value in the reference too: a
+# reference sweep over two ktilde whose other ktilde is far off must not enter the reference.
+for folder, axis_col, data in [(work / "ref_k", "axis.integrator.max_displacement", rows),
+                               (work / "new_k", "axis.integrator.max_entry_overlap", new_rows)]:
+    folder.mkdir(exist_ok=True)
+    out_rows = []
+    for k in (1e3, 1e5):
+        for r in data:
+            q = dict(r)
+            q["axis.contact.ktilde"] = k
+            if k == 1e5:
+                q["dv"] = float(q["dv"]) + 100.0
+            out_rows.append(q)
+    names = [c for c in (cols if data is rows else cols2)] + ["axis.contact.ktilde"]
+    with open(folder / "sweep.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=names)
+        w.writeheader()
+        w.writerows(out_rows)
+out = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(work / "new_k"),
+                      "--axis", "integrator.max_entry_overlap", "--reference-from",
+                      str(work / "ref_k"), "--reference-axis", "integrator.max_displacement",
+                      "--reference", "3e-4", "--only", "contact.ktilde=1e3"],
+                     capture_output=True, text=True, check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[4].endswith(", +4.0)"), f"dv cell {cells[4]!r}: the other ktilde entered the reference"
+assert any(l.startswith("| reference | 4 |") for l in out.splitlines()), out
 print("convergence_table: ok")
