@@ -210,6 +210,70 @@ BENCHMARK(conjugate_gradient<Eigen::IncompleteCholesky<double>>)
     ->Arg(4000)
     ->Unit(benchmark::kMillisecond);
 
+// A factorisation kept across steps (issue 13's route "keep a factorisation and iterate"):
+// conjugate gradients on step k+1's system, preconditioned by the exact factor of step k's, in
+// the pressure cell at J = 1e-4 (N = 1000; 30 or 3000 steps from the random packing, the second
+// 0.08 strain into its compaction, then 20 step pairs).
+// Counters: the mean iterations to a relative residual of 1e-6 and 1e-10, and the back-solves
+// one factorisation costs (CHOLMOD's flop counts): one iteration costs about one back-solve, so
+// the kept factor pays only if the iterations stay below that ratio.
+class PreviousFactor {
+ public:
+  void set(const sheardiff::SparseCholesky* f) { f_ = f; }
+  template <class M>
+  PreviousFactor& analyzePattern(const M&) { return *this; }
+  template <class M>
+  PreviousFactor& factorize(const M&) { return *this; }
+  template <class M>
+  PreviousFactor& compute(const M&) { return *this; }
+  Eigen::VectorXd solve(const Eigen::VectorXd& r) const { return f_->solve(r); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+
+ private:
+  const sheardiff::SparseCholesky* f_ = nullptr;
+};
+
+void cg_previous_step_factor(benchmark::State& state) {
+  sheardiff::Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.particles.n = static_cast<int>(state.range(0));
+  cfg.particles.phi_init = 0.75;
+  cfg.flow.j = 1e-4;
+  sheardiff::Simulation sim(cfg);
+  for (int k = 0; k < state.range(1); ++k) sim.step();
+  const auto& rs = sim.dynamics().force_balance().system();
+  double it6 = 0, it10 = 0, pairs = 0, ratio = 0;
+  for (auto _ : state) {
+    auto previous = sheardiff::make_sparse_cholesky("cholmod");
+    previous->analyze(rs.matrix());
+    previous->factorize(rs.matrix());
+    ratio = previous->solves_per_factorisation();
+    sim.step();
+    const Eigen::SparseMatrix<double> full = rs.matrix().selfadjointView<Eigen::Lower>();
+    for (double tol : {1e-6, 1e-10}) {
+      Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                               PreviousFactor>
+          cg;
+      cg.preconditioner().set(previous.get());
+      cg.setTolerance(tol);
+      cg.compute(full);
+      Eigen::VectorXd x = cg.solve(rs.rhs());
+      benchmark::DoNotOptimize(x.data());
+      (tol > 1e-8 ? it6 : it10) += static_cast<double>(cg.iterations());
+    }
+    pairs += 1;
+  }
+  state.counters["iterations_1e-6"] = it6 / pairs;
+  state.counters["iterations_1e-10"] = it10 / pairs;
+  state.counters["solves_per_factorisation"] = ratio;
+}
+#ifdef SHEARDIFF_HAVE_CHOLMOD
+BENCHMARK(cg_previous_step_factor)
+    ->Args({1000, 30})
+    ->Args({1000, 3000})
+    ->Iterations(20)->Unit(benchmark::kMillisecond);
+#endif
+
 }  // namespace
 
 BENCHMARK_MAIN();
