@@ -221,11 +221,17 @@ class PreviousFactor {
  public:
   void set(const sheardiff::SparseCholesky* f) { f_ = f; }
   template <class M>
-  PreviousFactor& analyzePattern(const M&) { return *this; }
+  PreviousFactor& analyzePattern(const M&) {
+    return *this;
+  }
   template <class M>
-  PreviousFactor& factorize(const M&) { return *this; }
+  PreviousFactor& factorize(const M&) {
+    return *this;
+  }
   template <class M>
-  PreviousFactor& compute(const M&) { return *this; }
+  PreviousFactor& compute(const M&) {
+    return *this;
+  }
   Eigen::VectorXd solve(const Eigen::VectorXd& r) const { return f_->solve(r); }
   Eigen::ComputationInfo info() const { return Eigen::Success; }
 
@@ -271,7 +277,8 @@ void cg_previous_step_factor(benchmark::State& state) {
 BENCHMARK(cg_previous_step_factor)
     ->Args({1000, 30})
     ->Args({1000, 3000})
-    ->Iterations(20)->Unit(benchmark::kMillisecond);
+    ->Iterations(20)
+    ->Unit(benchmark::kMillisecond);
 #endif
 
 }  // namespace
