@@ -68,6 +68,11 @@ def the_axis(given, axes):
     return given or (axes[0] if len(axes) == 1 else None)
 
 
+def with_value(rows, key, wanted):
+    """The rows whose axis KEY equals wanted."""
+    return [r for r in rows if float(r[f"axis.{key}"]) == wanted]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("dir")
@@ -94,7 +99,7 @@ def main():
         if not eq or f"axis.{key}" not in rows[0] or wanted is None:
             sys.exit(f"--only {cond}: give KEY=VALUE, a number for an axis KEY, one of "
                      f"{axes + ['run.seed']}")
-        rows = [r for r in rows if float(r[f"axis.{key}"]) == wanted]
+        rows = with_value(rows, key, wanted)
         if not rows:
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")
         only.append((cond, key, wanted))
@@ -115,10 +120,10 @@ def main():
         # An --only axis that REF_DIR also varies (e.g. ktilde) selects its reference points too.
         for cond, key, wanted in only:
             if f"axis.{key}" in ref_rows[0]:
-                ref_rows = [r for r in ref_rows if float(r[f"axis.{key}"]) == wanted]
+                ref_rows = with_value(ref_rows, key, wanted)
                 if not ref_rows:
                     sys.exit(f"--only {cond}: no finished point of {a.reference_from} has it")
-        ref_group = [r for r in ref_rows if float(r[f"axis.{ref_axis}"]) == ref_value]
+        ref_group = with_value(ref_rows, ref_axis, ref_value)
         if not ref_group:
             sys.exit(f"--reference {ref_value}: no finished point of {a.reference_from} has "
                      f"{ref_axis} = {ref_value}")
