@@ -4,7 +4,9 @@ sweep.csv (a sweep folder, or the store results/<name>/ that `sheardiff sweep ..
 writes) whose points vary one setting (the axis, e.g. integrator.max_displacement) over several
 seeds.
 
-Per value of the axis: the mean over seeds of phi, mu, dv, Psi, D and the largest overlap, each
+Per value of the axis: the mean over seeds of phi, mu, dv, Psi, D and the largest overlap (in a
+simple-shear sweep, whose phi is imposed: the shear viscosity eta_s / eta, the particle pressure
+P / (eta gammadot), mu = shear stress / P, dv, Psi, D and the largest overlap), each
 +- the standard error of that mean, the cost (steps and run seconds per strain), and each
 quantity's difference from the reference value of the axis (default: the smallest) in two units.
 The standard error is the larger of the seeds' scatter (s / sqrt(n)) and what the runs' own error
@@ -34,6 +36,18 @@ import sys
 QUANTITIES = [("phi", "phi"), ("mu", "mu"), ("dv", "dv / (gammadot d)"),
               ("psi", "Psi gammadot"), ("D", "D / (gammadot d^2)"),
               ("max_overlap", "largest overlap / d")]
+# Simple shear imposes phi; its summary gives the stresses (units of docs/units.md, gammadot = J).
+SIMPLE_SHEAR_QUANTITIES = [("viscosity", "eta_s / eta"), ("pressure_viscosity", "P / (eta gammadot)"),
+                           ("mu", "mu")] + QUANTITIES[2:]
+
+
+def quantity(r, q):
+    """Quantity q of one finished point, or None; simple shear's derived stresses from its summary."""
+    if q == "mu" and r.get("mu") in (None, "") and r.get("shear_stress") and r.get("pressure"):
+        return float(r["shear_stress"]) / float(r["pressure"])
+    if q == "pressure_viscosity":
+        return float(r["pressure"]) / float(r["J"]) if r.get("pressure") and r.get("J") else None
+    return None if r.get(q) in (None, "") else float(r[q])
 
 
 def mean_sem(xs):
@@ -135,30 +149,33 @@ def main():
         ref_group = groups[ref_value]
         ref_label = f"reference {ref_value:g}"
 
+    quantities = (SIMPLE_SHEAR_QUANTITIES if rows[0].get("scene") == "simple_shear"
+                  else QUANTITIES)
+
     def stats(rs, q):
-        m, e = mean_sem([float(r[q]) for r in rs if r.get(q) not in (None, "")])
+        m, e = mean_sem([x for x in (quantity(r, q) for r in rs) if x is not None])
         errs = [float(r[q + "_err"]) for r in rs if r.get(q + "_err") not in (None, "")]
         if m is not None and errs and len(errs) == len(rs):
             own = math.sqrt(sum(x * x for x in errs) / len(errs)) / math.sqrt(len(errs))
             e = own if e is None else max(e, own)
         return m, e
 
-    ref = {q: stats(ref_group, q) for q, _ in QUANTITIES}
+    ref = {q: stats(ref_group, q) for q, _ in quantities}
     print(f"{sum(len(v) for v in groups.values())} finished points; axis {axis}, {ref_label}. "
           f"Cells: mean over seeds +- standard error of the mean (the larger of the "
           f"seeds' scatter and the runs' own error bars); "
           f"(z, r) = difference from the reference in combined standard errors and in the "
           f"reference's standard error.\n")
-    print("| " + axis + " | seeds | " + " | ".join(h for _, h in QUANTITIES)
+    print("| " + axis + " | seeds | " + " | ".join(h for _, h in quantities)
           + " | steps / strain | run s / strain |")
-    print("|---" * (len(QUANTITIES) + 4) + "|")
+    print("|---" * (len(quantities) + 4) + "|")
     table = [(f"{v:g}", rs, not a.reference_from and v == ref_value)
              for v, rs in sorted(groups.items(), reverse=True)]
     if a.reference_from:
         table.append(("reference", ref_group, True))
     for label, rs, is_ref in table:
         cells = []
-        for q, _ in QUANTITIES:
+        for q, _ in quantities:
             m, e = stats(rs, q)
             cell = g(m, 4) + (f" +- {e:.2g}" if e is not None else "")
             rm, re = ref[q]

@@ -4,7 +4,8 @@ setting, four seeds each; the coarsest carries a bias of exactly 4 reference sta
 dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
 seed values); runs' own error bars larger than their scatter set the mean's error; an unknown
 axis must be refused; and a reference taken from another sweep (--reference-from) must give
-the same cells as the same points in one sweep. Usage: convergence_table_test.py REPO WORK"""
+the same cells as the same points in one sweep; a simple-shear sweep (phi imposed) must be read
+through its stresses, mu = shear stress / pressure. Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
 import subprocess
@@ -114,4 +115,33 @@ line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[4].endswith(", +4.0)"), f"dv cell {cells[4]!r}: the other ktilde entered the reference"
 assert any(l.startswith("| reference | 4 |") for l in out.splitlines()), out
+# A simple-shear sweep imposes phi: its table reads the viscosity, P / (eta gammadot) and
+# mu = shear stress / P from the summary's stresses. Shear stress 1.5 and 1.5 + 4 sem in the
+# coarsest setting at P = 3: mu must read r = +4.0 there and 0.5 in the reference.
+ss_dir = work / "simple_shear"
+ss_dir.mkdir(exist_ok=True)
+ss_cols = [c for c in cols if c not in ("phi", "mu")] + ["scene", "J", "shear_stress", "pressure",
+                                                          "viscosity"]
+ss_rows = []
+for r in rows:
+    q = {k: v for k, v in r.items() if k in ss_cols}
+    shift = 3 * (float(r["dv"]) - 3.0) / 10  # dv's offsets and bias, scaled to mu at P = 3
+    q.update(scene="simple_shear", J=1e-2, pressure=3.0, shear_stress=1.5 + shift,
+             viscosity=(1.5 + shift) / 1e-2)
+    ss_rows.append(q)
+with open(ss_dir / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=ss_cols)
+    w.writeheader()
+    w.writerows(ss_rows)
+out = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(ss_dir)],
+                     capture_output=True, text=True, check=True).stdout
+header = next(l for l in out.splitlines() if l.startswith("| integrator"))
+assert "eta_s / eta | P / (eta gammadot) | mu |" in header and "phi" not in header, header
+cells = [c.strip() for c in next(l for l in out.splitlines()
+                                 if l.startswith("| 0.003 |")).strip("|").split("|")]
+assert cells[3].startswith("300 +- 0"), f"P / (eta gammadot) cell {cells[3]!r}: want 3 / 1e-2"
+assert cells[4].endswith(", +4.0)"), f"mu cell {cells[4]!r}: want r = +4.0"
+ref_cells = [c.strip() for c in next(l for l in out.splitlines()
+                                     if l.startswith("| 0.0003 |")).strip("|").split("|")]
+assert ref_cells[4].startswith("0.5 +- "), f"mu cell {ref_cells[4]!r}: want 1.5 / 3"
 print("convergence_table: ok")

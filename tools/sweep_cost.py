@@ -1,0 +1,72 @@
+#!/usr/bin/python3
+"""What a sweep costs, from finished points: per (scene, N, ktilde, J) the mean steps per strain and
+exact factorisations per step of the stored summaries, and the floor those counts set on the CPU
+time of a run with one exact sparse factorisation per solve: factorisations per strain x the time
+of one factorisation (--ms-per-factorisation, measured with bench/bench_solver on the machine
+at hand). Steps and factorisations are machine-independent; the floor leaves out everything else
+a step does (solves, assembly, neighbour search, observers), so a real run costs more.
+
+    /usr/bin/python3 tools/sweep_cost.py STORE_OR_SWEEP_DIR... [--strains 33]
+        [--ms-per-factorisation 2.3] [--only N=1000]
+
+Each directory is a results store or a sweep folder (its points/*/summary.json are read)."""
+import argparse
+import glob
+import json
+import pathlib
+import sys
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("dirs", nargs="+")
+    ap.add_argument("--strains", type=float, default=33.0,
+                    help="strains per point, transient included (the seed's protocol: 3 + 30)")
+    ap.add_argument("--ms-per-factorisation", type=float, default=2.3,
+                    help="CPU ms of one factorisation (bench_solver; 2.3 at N = 1000 here)")
+    ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
+                    help="keep the summaries whose KEY (N, ktilde, J, scene) equals VALUE")
+    a = ap.parse_args()
+    if a.strains <= 0 or a.ms_per_factorisation <= 0:
+        sys.exit("--strains and --ms-per-factorisation must be > 0")
+    only = []
+    for cond in a.only:
+        key, eq, value = cond.partition("=")
+        if not eq or key not in ("N", "ktilde", "J", "scene"):
+            sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of N, ktilde, J, scene")
+        only.append((key, value))
+    groups = {}
+    for d in a.dirs:
+        files = glob.glob(str(pathlib.Path(d) / "points" / "*" / "summary.json"))
+        if not files:
+            sys.exit(f"{d}: no points/*/summary.json (a results store or a sweep folder)")
+        for f in files:
+            s = json.load(open(f))
+            if not s.get("steps") or "factorisations" not in s:
+                continue  # a summary from before the solver's counters
+            if any(str(s.get(k)) != v and not (k != "scene" and float(s.get(k)) == float(v))
+                   for k, v in only):
+                continue
+            key = (s["scene"], s["N"], s["ktilde"], s["J"])
+            groups.setdefault(key, []).append(s)
+    if not groups:
+        sys.exit("no summary with steps and factorisations matched")
+    print(f"floor = factorisations per strain x {a.ms_per_factorisation:g} ms; "
+          f"per point: {a.strains:g} strains\n")
+    print("| scene | N | ktilde | J | points | steps / strain | factorisations / step "
+          "| floor CPU s / strain | floor CPU h / point |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    total = 0.0
+    for (scene, n, k, j), ss in sorted(groups.items()):
+        steps = sum(s["steps_per_strain"] for s in ss) / len(ss)
+        fact = sum(s["factorisations"] / s["steps"] for s in ss) / len(ss)
+        floor = steps * fact * a.ms_per_factorisation / 1e3
+        hours = floor * a.strains / 3600
+        total += hours
+        print(f"| {scene} | {n} | {k:g} | {j:g} | {len(ss)} | {steps:,.0f} | {fact:.2f} "
+              f"| {floor:.1f} | {hours:.2f} |")
+    print(f"\none point of each row: {total:.2f} CPU h of factorisations at least")
+
+
+if __name__ == "__main__":
+    main()
