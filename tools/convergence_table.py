@@ -37,7 +37,8 @@ QUANTITIES = [("phi", "phi"), ("mu", "mu"), ("dv", "dv / (gammadot d)"),
               ("psi", "Psi gammadot"), ("D", "D / (gammadot d^2)"),
               ("max_overlap", "largest overlap / d")]
 # Simple shear imposes phi; its summary gives the stresses (units of docs/units.md, gammadot = J).
-SIMPLE_SHEAR_QUANTITIES = [("viscosity", "eta_s / eta"), ("pressure_viscosity", "P / (eta gammadot)"),
+SIMPLE_SHEAR_QUANTITIES = [("viscosity", "eta_s / eta"),
+                           ("pressure_viscosity", "P / (eta gammadot)"),
                            ("mu", "mu")] + QUANTITIES[2:]
 
 

@@ -34,6 +34,11 @@ def main():
         key, eq, value = cond.partition("=")
         if not eq or key not in ("N", "ktilde", "J", "scene"):
             sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of N, ktilde, J, scene")
+        if key != "scene":
+            try:
+                value = float(value)
+            except ValueError:
+                sys.exit(f"--only {cond}: {key} takes a number")
         only.append((key, value))
     groups = {}
     for d in a.dirs:
@@ -44,7 +49,7 @@ def main():
             s = json.load(open(f))
             if not s.get("steps") or "factorisations" not in s:
                 continue  # a summary from before the solver's counters
-            if any(str(s.get(k)) != v and not (k != "scene" and float(s.get(k)) == float(v))
+            if any(s.get(k) != v if k == "scene" else float(s.get(k, "nan")) != v
                    for k, v in only):
                 continue
             key = (s["scene"], s["N"], s["ktilde"], s["J"])

@@ -36,7 +36,9 @@ assert cells[4:] == ["2", "11,000", "2.00", "44.0", "0.44"], cells
 assert "0.44 CPU h" in out, out
 out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
 assert len([l for l in out.splitlines() if l.startswith("| pressure_shear")]) == 2, out
-for bad_args in (["--only", "seed=1"], ["--strains", "0"]):
+out = subprocess.run(tool + ["--only", "scene=simple_shear"], capture_output=True, text=True)
+assert out.returncode != 0 and "no summary" in out.stderr, out.stderr
+for bad_args in (["--only", "seed=1"], ["--only", "J=abc"], ["--strains", "0"]):
     bad = subprocess.run(tool + bad_args, capture_output=True, text=True)
     assert bad.returncode != 0 and bad_args[0] in bad.stderr, bad.stderr
 bad = subprocess.run([sys.executable, str(repo / "tools/sweep_cost.py"), str(work / "none")],
