@@ -297,6 +297,14 @@ const std::vector<KeySpec>& schema() {
                      "Relative change of mean H allowed between the window halves."));
     s.push_back(real("steady.mu_tolerance", &C::steady, &C::Steady::mu_tolerance, 0.0, 10.0, true,
                      "", "Change of mean mu allowed between the window halves."));
+    s.push_back(real("steady.drift_z", &C::steady, &C::Steady::drift_z, 0.0, 100.0, true, "",
+                     "pressure_shear: the measured window is stationary when the net y drag on "
+                     "the discs, mu_top - mu_bottom and the change of H across it are each zero "
+                     "within this many standard errors (time blocks of analysis.error_block)."));
+    s.push_back(real("steady.bulk_load_tolerance", &C::steady, &C::Steady::bulk_load_tolerance, 0.0,
+                     1.0, true, "",
+                     "pressure_shear: ... and when -sigma_yy of the pair forces in the bulk is P "
+                     "within this fraction."));
     s.push_back(real("steady.measure_strain", &C::steady, &C::Steady::measure_strain, 0.0, 1e5,
                      false, "1 (strain)",
                      "pressure_shear: strain simulated after steady state, then stop (0 = run to "

@@ -93,6 +93,8 @@ struct Config {
     double h_tolerance = 0.01;    // relative drift of H allowed between the window halves
     double mu_tolerance = 0.05;   // drift of mu allowed between the window halves
     double measure_strain = 0.0;  // strain run after steady state (0 = until run.strain)
+    double drift_z = 3.0;               // standard errors a window's drift signals may reach
+    double bulk_load_tolerance = 0.05;  // of P, for the bulk's -sigma_yy
   } steady;
   struct Observables {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi

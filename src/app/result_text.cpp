@@ -30,6 +30,18 @@ long count(const nlohmann::json& js, const char* key) {
   return it != js.end() && it->is_number() ? it->get<long>() : 0L;
 }
 
+// The measured window's stationarity signals, one line, and what failed.
+std::string stationarity_text(const nlohmann::json& js) {
+  std::string out = fmt::format(
+      "  stationarity of the window: net y drag {:.3g} +- {:.2g} P, mu_top - mu_bottom {:.3g} +- "
+      "{:.2g}, H change {:.3g} +- {:.2g} d, bulk normal load {:.4f} +- {:.2g} P: {}\n",
+      num(js, "net_drag_y"), num(js, "net_drag_y_err"), num(js, "mu_top_minus_bottom"),
+      num(js, "mu_top_minus_bottom_err"), num(js, "H_change"), num(js, "H_change_err"),
+      num(js, "bulk_normal_load"), num(js, "bulk_normal_load_err"),
+      flag(js, "stationary") ? "stationary" : "DRIFTING");
+  return out;
+}
+
 }  // namespace
 
 std::string run_result_first_line(const nlohmann::json& summary, const std::string& out_dir) {
@@ -76,6 +88,7 @@ std::string run_result_details(const nlohmann::json& summary) {
           "held steps)\n",
           num(summary, "pressure_measured"), num(summary, "pressure_max_relative_error"),
           count(summary, "steps") - count(summary, "wall_free_fall_steps"));
+      if (summary.contains("stationary")) details += stationarity_text(summary);
     }
   } else if (std::isnan(num(summary, "shear_stress"))) {
     details += fmt::format("  no averages: the run ended before run.transient_strain\n");
@@ -105,6 +118,8 @@ std::string analysis_result_text(const nlohmann::json& js, const std::string& ru
 }
 
 void print_warnings(const nlohmann::json& js) {
+  if (const auto w = js.find("stationarity_warning"); w != js.end() && w->is_string())
+    fmt::print(stderr, "warning: {}\n", w->get<std::string>());
   const auto it = js.find("analysis_warnings");
   if (it == js.end() || !it->is_array()) return;
   for (const auto& w : *it)

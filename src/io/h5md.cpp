@@ -1108,6 +1108,10 @@ ContactNetwork read_h5md_contacts(const fs::path& file, long frame) {
   return c;
 }
 
+bool has_h5md_observable(const fs::path& file, const std::string& name) {
+  return !name.empty() && Reader(file).exists("/observables/" + name);
+}
+
 ObservableSeries read_h5md_observable(const fs::path& file, const std::string& name) {
   const Reader r(file);
   const std::string base = "/observables/" + name;

@@ -1,11 +1,14 @@
 #include "sheardiff/observe/pressure_cell.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/analysis/uncertainty.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/observe/stress.hpp"
 
 namespace sheardiff {
 
@@ -28,6 +31,57 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
   js["mu_bottom_err"] = err(mu_bottom);
 }
 
+StationarityVerdict pressure_cell_stationarity(
+    const Config::Steady& cfg, const std::vector<double>& strain, const std::vector<double>& h,
+    const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
+    const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
+    double to, double block) {
+  StationarityVerdict v;
+  if (!(to > from) || strain.size() < 8) return v;
+  const long blocks = std::max(4L, static_cast<long>((to - from) / block));
+  std::vector<double> dmu(mu_top.size());
+  for (std::size_t k = 0; k < dmu.size(); ++k) dmu[k] = mu_top[k] - mu_bottom[k];
+  const double z = cfg.drift_z;
+  v.signals.push_back(
+      mean_within_noise("net_drag_y", strain, net_drag_y, 0.0, from, to, blocks, z));
+  v.signals.push_back(
+      mean_within_noise("mu_top_minus_bottom", strain, dmu, 0.0, from, to, blocks, z));
+  v.signals.push_back(trend_within_noise("H_change", strain, h, from, to, blocks, z));
+  v.signals.push_back(mean_within_tolerance("bulk_normal_load", strain, bulk_load, 1.0, from, to,
+                                            blocks, cfg.bulk_load_tolerance));
+  return v;
+}
+
+void add_stationarity(nlohmann::json& js, const StationarityVerdict& v) {
+  const auto num = [](double x) {
+    return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+  };
+  js["stationary"] = v.stationary();
+  js["not_stationary"] = v.signals.empty() ? std::string("window too short") : v.failed();
+  for (const DriftSignal& s : v.signals) {
+    js[s.name] = num(s.expected + s.value);
+    js[s.name + "_err"] = num(s.err);
+  }
+  if (!v.stationary())
+    js["stationarity_warning"] = fmt::format(
+        "the measured window is not stationary ({}): its averages describe a transient; run "
+        "longer or start nearer the steady state (docs/model.md, \"Steady state\")",
+        js["not_stationary"].get<std::string>());
+}
+
+namespace {
+
+// The bulk band: wall_exclusion inside each wall's centre line, or the whole gap of a thin cell.
+std::pair<double, double> bulk_band(const Dynamics& d, double exclusion) {
+  const Particles& p = d.particles();
+  const double yb = mean_height(p, d.walls()->bottom), yt = mean_height(p, d.walls()->top);
+  double y1 = yb + exclusion, y2 = yt - exclusion;
+  if (y2 - y1 < 1.0) y1 = yb, y2 = yt;
+  return {y1, y2};
+}
+
+}  // namespace
+
 PressureCellObserver::PressureCellObserver(const Config& cfg)
     : steady_cfg_(cfg.steady),
       exclusion_(cfg.observables.wall_exclusion),
@@ -38,9 +92,7 @@ PressureCellObserver::PressureCellObserver(const Config& cfg)
 
 double PressureCellObserver::bulk_phi(const Dynamics& d, double exclusion) {
   const Particles& p = d.particles();
-  const double yb = mean_height(p, d.walls()->bottom), yt = mean_height(p, d.walls()->top);
-  double y1 = yb + exclusion, y2 = yt - exclusion;
-  if (y2 - y1 < 1.0) y1 = yb, y2 = yt;  // a thin cell has no bulk: use the whole gap
+  const auto [y1, y2] = bulk_band(d, exclusion);
   double area = 0.0;
   for (std::size_t i = 0; i < p.n_mobile; ++i)
     area += disc_area_between(p.position[i].y(), p.radius[i], y1, y2);
@@ -48,27 +100,40 @@ double PressureCellObserver::bulk_phi(const Dynamics& d, double exclusion) {
 }
 
 std::vector<std::string> PressureCellObserver::frame_names() const {
-  return {"H", "phi", "mu_top", "mu_bottom", "pressure_measured", "wall_velocity_y"};
+  return {"H",
+          "phi",
+          "mu_top",
+          "mu_bottom",
+          "pressure_measured",
+          "wall_velocity_y",
+          "net_drag_y",
+          "bulk_normal_load"};
 }
 
 std::vector<std::string> PressureCellObserver::frame_units() const {
-  return {"d", "1", "1", "1", "P", "P d eta-1"};
+  return {"d", "1", "1", "1", "P", "P d eta-1", "P", "P"};
 }
 
 void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& values) {
   const Dynamics& d = v.dynamics;
   const double a = d.box().lx * lz_;
   const double mu_top = -v.stress.top_wall_fx / a / pressure_;
-  const double h = d.height();
-  values.insert(values.end(),
-                {h, bulk_phi(d, exclusion_), mu_top, v.stress.bottom_wall_fx / a / pressure_,
-                 v.stress.top_wall_fy / a, v.velocities.wall_v});
+  const double h = d.height(), phi = bulk_phi(d, exclusion_);
+  const double mu_bottom = v.stress.bottom_wall_fx / a / pressure_;
+  // The walls' load difference is the y drag of the fluid on the discs: positive when they sink.
+  const double drag = (v.stress.top_wall_fy + v.stress.bottom_wall_fy) / a / pressure_;
+  const auto [y1, y2] = bulk_band(d, exclusion_);
+  const double load = normal_load_between(d, v.velocities, y1, y2, lz_) / pressure_;
+  values.insert(values.end(), {h, phi, mu_top, mu_bottom, v.stress.top_wall_fy / a,
+                               v.velocities.wall_v, drag, load});
   if (steady()) {
     s_strain_.push_back(d.strain());
     s_h_.push_back(h);
-    s_phi_.push_back(values[values.size() - 5]);
+    s_phi_.push_back(phi);
     s_mu_top_.push_back(mu_top);
-    s_mu_bottom_.push_back(values[values.size() - 3]);
+    s_mu_bottom_.push_back(mu_bottom);
+    s_drag_.push_back(drag);
+    s_load_.push_back(load);
     return;
   }
   hist_strain_.push_back(d.strain());
@@ -153,6 +218,9 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["measured_strain"] = d.strain() - steady_at_;
   add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, d.strain(),
                     error_block_);
+  add_stationarity(
+      js, pressure_cell_stationarity(steady_cfg_, s_strain_, s_h_, s_mu_top_, s_mu_bottom_, s_drag_,
+                                     s_load_, steady_at_, d.strain(), error_block_));
   (void)writer;
 }
 

@@ -67,6 +67,27 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
   return s;
 }
 
+double normal_load_between(const Dynamics& d, const Velocities& v, double y1, double y2,
+                           double lz) {
+  if (!(y2 > y1)) return 0.0;
+  const auto& pairs = d.neighbours().pairs();
+  const auto& terms = d.force_balance().terms();
+  const Particles& p = d.particles();
+  double load = 0.0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const PairTerm& t = terms[k];
+    if (!t.on) continue;
+    const Pair& pr = pairs[k];
+    const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y();
+    if (mid < y1 || mid >= y2) continue;
+    // Lever arm r (not the stress convention's s for open pairs): sum of dy_ij f_y over the
+    // band's pairs is exactly the band's mean of the force across a horizontal line.
+    const Vec2 fj = t.force(v.u[pr.i], v.u[pr.j]).segment<2>(3);
+    load += t.g.r * t.g.n.y() * fj.y();
+  }
+  return load / (d.box().lx * (y2 - y1) * lz);
+}
+
 ContactNetwork contact_network(const Dynamics& d) {
   ContactNetwork c;
   const Particles& p = d.particles();

@@ -279,8 +279,13 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
       }
       // A pressure-cell run that never reached steady state has no phi(J) or mu(J) to fit.
       const bool unsteady = summary.contains("steady") && !summary["steady"].get<bool>();
+      // One whose measured window drifted (or was too short to judge) measured a transient.
+      const bool drifting = !unsteady && summary.contains("stationary") &&
+                            summary["stationary"].is_boolean() &&
+                            !summary["stationary"].get<bool>();
       if (unsteady) row["status"] = "done, not steady";
-      if (summary.contains("J") && !unsteady)
+      if (drifting) row["status"] = "done, not stationary";
+      if (summary.contains("J") && !unsteady && !drifting)
         groups[group_key][summary["J"].get<double>()].push_back(summary);
       group_axes[group_key] = axes;
     }

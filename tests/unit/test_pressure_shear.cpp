@@ -142,6 +142,27 @@ TEST(PressureShear, SteadyPhiIndependentOfInitialFraction) {
       << a["phi"] << " vs " << b["phi"];
 }
 
+// A dense start at J = 0.1 dilates for tens of strains (drag-limited: the load P = 10 eta
+// gammadot is of the order of the drag of a slow collective flow). The half-window detector
+// declares it steady within a few strains; the window test must see the drift: the packing
+// rises (H grows) and the fluid drags the discs down (net_drag_y < 0), both beyond the noise.
+TEST(PressureShear, DilatingWindowIsFlaggedNotStationary) {
+  Config c = cell_config(250, 0.1, 1e4, 0.75, 5);
+  c.run.strain = 12.0;
+  c.steady.window = 1.5;
+  c.steady.measure_strain = 5.0;
+  c.output.frame_strain = 0.05;
+  c.analysis.error_block = 1.0;
+  const auto js = run_summary(c, "dilating");
+  ASSERT_TRUE(js["steady"].get<bool>()) << "the half-window detector fired (as it does)";
+  EXPECT_FALSE(js["stationary"].get<bool>());
+  EXPECT_NE(js["not_stationary"].get<std::string>().find("net_drag_y"), std::string::npos)
+      << js["not_stationary"];
+  EXPECT_GT(js["H_change"].get<double>(), 3.0 * js["H_change_err"].get<double>());
+  EXPECT_LT(js["net_drag_y"].get<double>(), -3.0 * js["net_drag_y_err"].get<double>());
+  EXPECT_TRUE(js.contains("stationarity_warning"));
+}
+
 TEST(PressureShear, WallStaysAboveAndOverlapScalesAsOneOverK) {
   double max_overlap[2] = {0, 0};
   const double ks[2] = {1e3, 1e4};

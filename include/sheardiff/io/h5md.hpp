@@ -117,6 +117,8 @@ struct ObservableSeries {
   std::vector<double> value;
 };
 ObservableSeries read_h5md_observable(const std::filesystem::path& file, const std::string& name);
+// Whether the file has the observable (runs of older versions recorded fewer).
+bool has_h5md_observable(const std::filesystem::path& file, const std::string& name);
 
 // Plain-text table "x y diameter" (whitespace separated, '#' comments, blank lines ignored).
 // Throws naming the file and line number on a malformed line (wrong column count,

@@ -1,6 +1,7 @@
 #pragma once
 #include <vector>
 
+#include "sheardiff/analysis/stationarity.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/profiles.hpp"
@@ -13,6 +14,19 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
                        const std::vector<double>& h, const std::vector<double>& phi,
                        const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
                        double from, double to, double block);
+
+// Whether the window [from, to] of a pressure cell was stationary: the net y drag on the discs
+// (the walls' load difference over P Lx lz) and mu_top - mu_bottom zero, and H without a trend,
+// each within steady.drift_z standard errors; the bulk's normal load P within
+// steady.bulk_load_tolerance. Samples as in add_steady_errors, blocks of `block` strain.
+StationarityVerdict pressure_cell_stationarity(
+    const Config::Steady& cfg, const std::vector<double>& strain, const std::vector<double>& h,
+    const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
+    const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
+    double to, double block);
+// Its signals into summary.json: stationary, not_stationary (the failed signals), and each
+// signal's value and error (net_drag_y, mu_top_minus_bottom, H_change, bulk_normal_load).
+void add_stationarity(nlohmann::json& js, const StationarityVerdict& v);
 
 // Observables of the pressure-imposed plane shear cell (docs/model.md section 9): gap H, bulk phi,
 // mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
@@ -35,7 +49,8 @@ class PressureCellObserver final : public Observer {
                       &p_meas_, &max_p_err_})
       a.io(*x);
     a.io(free_fall_steps_);
-    for (auto* v : {&s_strain_, &s_h_, &s_phi_, &s_mu_top_, &s_mu_bottom_}) a.io(*v);
+    for (auto* v : {&s_strain_, &s_h_, &s_phi_, &s_mu_top_, &s_mu_bottom_, &s_drag_, &s_load_})
+      a.io(*v);
   }
 
   bool steady() const { return steady_at_ >= 0.0; }
@@ -55,6 +70,8 @@ class PressureCellObserver final : public Observer {
   long free_fall_steps_ = 0;
   // Frame samples of the steady window, for the error bars.
   std::vector<double> s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_;
+  // ... and of the stationarity signals (net y drag on the discs, the bulk's normal load).
+  std::vector<double> s_drag_, s_load_;
 };
 
 }  // namespace sheardiff

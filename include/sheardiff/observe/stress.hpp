@@ -24,6 +24,12 @@ StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz);
 // The same with pair terms other than the last solve's (a stage of a multi-stage integrator).
 StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& terms,
                             const Velocities& v, double lz);
+// The normal load a horizontal band of the packing carries, in pressure units: sum over the
+// pairs whose midpoints lie between heights y1 < y2 of (y_j - y_i) f_y on j, over the band's
+// area (-sigma_yy with the lever arm r for every pair). Where nothing moves on average in y,
+// momentum balance makes it equal the load on the walls at every height; a packing that
+// dilates from its middle carries more than P there though its net drag is zero.
+double normal_load_between(const Dynamics& d, const Velocities& v, double y1, double y2, double lz);
 // Weighted mean of two samples (stresses, wall forces, overlaps); the contact count of `a`.
 StressSample average(const StressSample& a, const StressSample& b);
 

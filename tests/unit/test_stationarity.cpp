@@ -1,0 +1,137 @@
+// The steady-state window test (src/analysis/stationarity.cpp) on synthetic series whose truth is
+// known. A stationary AR(1) series (correlation time 0.5 strain, well inside the 3-strain error
+// blocks of a 30-strain window) must pass at z = 3 in all but a few per cent of trials: with 10
+// blocks the statistic is close to Student's t with 9 (mean) or 8 (trend) degrees of freedom,
+// whose two-sided tail beyond 3 is 1.5-1.7 %; 400 trials give a binomial sd of 0.6 %, so a rate
+// above 5 % means the errors are underestimated by about a third. A drift whose effect is six
+// errors must be caught in at least 90 % of trials (the t statistic's power there is > 98 %).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "sheardiff/analysis/stationarity.hpp"
+#include "sheardiff/observe/pressure_cell.hpp"
+
+namespace sd = sheardiff;
+
+namespace {
+
+constexpr double kDt = 0.02, kFrom = 3.0, kTo = 33.0;  // frames, the measured window (strain)
+constexpr long kBlocks = 10;                           // of 3 strain, as analysis.error_block
+constexpr int kTrials = 400;
+
+std::vector<double> times() {
+  std::vector<double> t;
+  for (double s = kFrom; s <= kTo + 1e-9; s += kDt) t.push_back(s);
+  return t;
+}
+
+// Unit-variance AR(1) noise of correlation time tau (strain) plus drift * (t - kFrom) + offset.
+std::vector<double> series(const std::vector<double>& t, double tau, double offset, double drift,
+                           std::mt19937_64& rng) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double a = std::exp(-kDt / tau);
+  double x = g(rng);
+  std::vector<double> out;
+  for (double s : t) {
+    out.push_back(x + offset + drift * (s - kFrom));
+    x = a * x + std::sqrt(1 - a * a) * g(rng);
+  }
+  return out;
+}
+
+// The error of a 30-strain mean of that noise: sqrt(2 tau / T) for tau << T.
+double mean_error(double tau) {
+  return std::sqrt(2.0 * tau / (kTo - kFrom));
+}
+
+}  // namespace
+
+TEST(Stationarity, StationaryNoiseRarelyFlagged) {
+  std::mt19937_64 rng(11);
+  const auto t = times();
+  int mean_flags = 0, trend_flags = 0;
+  for (int k = 0; k < kTrials; ++k) {
+    const auto x = series(t, 0.5, 0.0, 0.0, rng);
+    mean_flags += !sd::mean_within_noise("x", t, x, 0.0, kFrom, kTo, kBlocks, 3.0).ok;
+    trend_flags += !sd::trend_within_noise("x", t, x, kFrom, kTo, kBlocks, 3.0).ok;
+  }
+  EXPECT_LT(mean_flags, 0.05 * kTrials);
+  EXPECT_LT(trend_flags, 0.05 * kTrials);
+  // And not a test that never flags anything: some false alarms are expected (1.5 % of 400 = 6).
+  EXPECT_GT(mean_flags + trend_flags, 0);
+}
+
+TEST(Stationarity, OffsetAndDriftOfSixErrorsCaught) {
+  std::mt19937_64 rng(12);
+  const auto t = times();
+  const double e = mean_error(0.5);
+  int offset_caught = 0, drift_caught = 0;
+  for (int k = 0; k < kTrials; ++k) {
+    const auto off = series(t, 0.5, 6.0 * e, 0.0, rng);
+    offset_caught += !sd::mean_within_noise("x", t, off, 0.0, kFrom, kTo, kBlocks, 3.0).ok;
+    // The OLS line through n block means (each with error e sqrt(n)) has a change across the
+    // window with error e n sqrt(12 / (n^2 - 1)); a drift of 6 such errors:
+    const double change_err = e * kBlocks * std::sqrt(12.0 / (kBlocks * kBlocks - 1.0));
+    const auto drifting = series(t, 0.5, 0.0, 6.0 * change_err / (kTo - kFrom), rng);
+    drift_caught += !sd::trend_within_noise("x", t, drifting, kFrom, kTo, kBlocks, 3.0).ok;
+  }
+  EXPECT_GT(offset_caught, 0.9 * kTrials);
+  EXPECT_GT(drift_caught, 0.9 * kTrials);
+}
+
+TEST(Stationarity, ToleranceIsAbsolute) {
+  std::mt19937_64 rng(13);
+  const auto t = times();
+  const auto near = series(t, 0.5, 1.03, 0.0, rng);
+  const auto far = series(t, 0.5, 1.07, 0.0, rng);
+  // The noise is 1 P here and its window error ~0.18: an absolute tolerance of 0.05 P ignores it
+  // only where the mean is far from the bound; shrink the noise so the means are sharp.
+  std::vector<double> a, b;
+  for (std::size_t k = 0; k < t.size(); ++k)
+    a.push_back(1.03 + 0.01 * (near[k] - 1.03)), b.push_back(1.07 + 0.01 * (far[k] - 1.07));
+  const auto pass = sd::mean_within_tolerance("load", t, a, 1.0, kFrom, kTo, kBlocks, 0.05);
+  const auto fail = sd::mean_within_tolerance("load", t, b, 1.0, kFrom, kTo, kBlocks, 0.05);
+  EXPECT_TRUE(pass.ok);
+  // The window error of these means is 0.0018: 0.006 is 3.3 of it.
+  EXPECT_NEAR(pass.value, 0.03, 0.006);
+  EXPECT_FALSE(fail.ok);
+  EXPECT_NEAR(fail.value, 0.07, 0.006);
+}
+
+TEST(Stationarity, TooShortWindowIsNotStationary) {
+  const std::vector<double> t = {0.0, 0.1, 0.2}, x = {1.0, 1.0, 1.0};
+  // Three blocks cannot give a trend with its own error.
+  EXPECT_FALSE(sd::trend_within_noise("x", t, x, 0.0, 0.2, 3, 3.0).ok);
+  EXPECT_FALSE(sd::StationarityVerdict{}.stationary());
+}
+
+// The pressure cell's verdict names the signal that drifted: a dilation's drag on the discs
+// (mean 0.05 P against a window error of ~0.01) with mu, H and the bulk load steady.
+TEST(Stationarity, PressureCellNamesTheDriftingSignal) {
+  std::mt19937_64 rng(14);
+  const auto t = times();
+  auto scaled = [&](double level, double noise, double drift) {
+    auto x = series(t, 0.5, 0.0, 0.0, rng);
+    for (std::size_t k = 0; k < x.size(); ++k) x[k] = level + noise * x[k] + drift * (t[k] - kFrom);
+    return x;
+  };
+  const auto h = scaled(40.0, 0.3, 0.0), top = scaled(0.5, 0.05, 0.0);
+  const auto bottom = scaled(0.5, 0.05, 0.0), load = scaled(1.0, 0.05, 0.0);
+  sd::Config::Steady cfg;
+  const auto still = scaled(0.0, 0.05, 0.0), sinking = scaled(0.05, 0.05, 0.0);
+  const auto ok =
+      sd::pressure_cell_stationarity(cfg, t, h, top, bottom, still, load, kFrom, kTo, 3.0);
+  const auto bad =
+      sd::pressure_cell_stationarity(cfg, t, h, top, bottom, sinking, load, kFrom, kTo, 3.0);
+  EXPECT_TRUE(ok.stationary()) << ok.failed();
+  EXPECT_FALSE(bad.stationary());
+  EXPECT_EQ(bad.failed(), "net_drag_y");
+  // A wall that keeps falling 0.09 d per strain (2.7 d over the window, the H noise 0.3 d).
+  const auto falling = scaled(40.0, 0.3, -0.09);
+  const auto fell =
+      sd::pressure_cell_stationarity(cfg, t, falling, top, bottom, still, load, kFrom, kTo, 3.0);
+  EXPECT_EQ(fell.failed(), "H_change");
+  EXPECT_NEAR(fell.signals[2].value, -2.7, 0.5);
+}

@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Was a pressure-cell window stationary? Two uses (docs/model.md, "Steady state").
+
+  stationarity_check.py store RESULTS_DIR
+      Every stored point: its run's verdict (`stationary`, `not_stationary`) where the run
+      recorded one; for points run before the verdict existed, the one signal their summaries
+      still hold, mu_top - mu_bottom against its error (the two walls' errors combined as if
+      independent, an approximation).
+
+  stationarity_check.py approach RUN_DIR [--window W] [--block B] [--z Z] [--tolerance T]
+      A run's trajectory observables (H, mu_top, mu_bottom, net_drag_y, bulk_normal_load) in
+      consecutive windows of W strain: the window means and the verdict of the same four
+      signals as the run's own test, so that the strain at which a start reaches steady state
+      can be read off.
+"""
+import argparse
+import glob
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+
+def store(path):
+    rows = []
+    for f in sorted(glob.glob(os.path.join(path, "points", "*", "summary.json"))):
+        s = json.load(open(f))
+        name = os.path.basename(os.path.dirname(f))
+        if "stationary" in s:
+            verdict = "stationary" if s["stationary"] else "DRIFTING: " + s.get("not_stationary", "")
+            rows.append((s.get("J", math.nan), name, verdict))
+            continue
+        if not all(k in s for k in ("mu_top", "mu_bottom", "mu_top_err", "mu_bottom_err")):
+            rows.append((s.get("J", math.nan), name, "no verdict: no steady window"))
+            continue
+        d = s["mu_top"] - s["mu_bottom"]
+        e = math.hypot(s["mu_top_err"], s["mu_bottom_err"])
+        z = d / e if e > 0 else math.inf
+        verdict = "mu_top - mu_bottom = {:+.3f} +- {:.3f} (z = {:+.1f}): {}".format(
+            d, e, z, "within noise" if abs(z) <= 3 else "DRIFTING")
+        rows.append((s.get("J", math.nan), name, verdict + " (only signal stored)"))
+    for _, name, verdict in sorted(rows):
+        print(f"{name:28s} {verdict}")
+
+
+def block_stats(x, t, lo, hi, blocks):
+    edges = np.linspace(lo, hi, blocks + 1)
+    means = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        m = (t >= a) & (t < b)
+        if m.any():
+            means.append(x[m].mean())
+    means = np.array(means)
+    if len(means) < 2:
+        return math.nan, math.nan, means
+    return means.mean(), means.std(ddof=1) / math.sqrt(len(means)), means
+
+
+def approach(run, window, block, z, tolerance):
+    import h5py
+
+    cfg_j = None
+    for line in open(os.path.join(run, "config.toml")):
+        if line.strip().startswith("J ="):
+            cfg_j = float(line.split("=")[1])
+    with h5py.File(os.path.join(run, "trajectory.h5"), "r", locking=False) as f:
+        o = f["observables"]
+        # Time is in eta / P; strain = gammadot t = J t in these units (docs/units.md).
+        t = o["H/time"][:] * cfg_j
+        series = {n: o[n + "/value"][:] for n in
+                  ("H", "phi", "mu_top", "mu_bottom", "net_drag_y", "bulk_normal_load")}
+    n = min(len(t), *(len(v) for v in series.values()))
+    t = t[:n]
+    series = {k: v[:n] for k, v in series.items()}
+    blocks = max(4, int(window / block))
+    print(f"{run}: J = {cfg_j:g}, windows of {window:g} strain, {blocks} blocks each, z = {z:g}")
+    print(" from   to     phi      H      net_drag_y        mu_t-mu_b       H change       bulk load  verdict")
+    lo = 0.0
+    while lo + window <= t[-1] + 1e-9:
+        hi = lo + window
+        failed = []
+        drag, drag_e, _ = block_stats(series["net_drag_y"], t, lo, hi, blocks)
+        dmu, dmu_e, _ = block_stats(series["mu_top"] - series["mu_bottom"], t, lo, hi, blocks)
+        _, _, hb = block_stats(series["H"], t, lo, hi, blocks)
+        mid = lo + (np.arange(len(hb)) + 0.5) * (window / blocks)
+        fit = np.polyfit(mid, hb, 1)
+        res = hb - np.polyval(fit, mid)
+        se = math.sqrt((res ** 2).sum() / (len(hb) - 2) / ((mid - mid.mean()) ** 2).sum())
+        hchange, hchange_e = fit[0] * window, se * window
+        load, load_e, _ = block_stats(series["bulk_normal_load"], t, lo, hi, blocks)
+        if abs(drag) > z * drag_e:
+            failed.append("net_drag_y")
+        if abs(dmu) > z * dmu_e:
+            failed.append("mu_top_minus_bottom")
+        if abs(hchange) > z * hchange_e:
+            failed.append("H_change")
+        if abs(load - 1.0) > tolerance:
+            failed.append("bulk_normal_load")
+        m = (t >= lo) & (t < hi)
+        print(f"{lo:5.1f} {hi:5.1f}  {series['phi'][m].mean():.4f} {series['H'][m].mean():6.2f}"
+              f"  {drag:+.3f} +- {drag_e:.3f}  {dmu:+.3f} +- {dmu_e:.3f}"
+              f"  {hchange:+.2f} +- {hchange_e:.2f}  {load:.3f} +- {load_e:.3f}  "
+              + ("stationary" if not failed else "DRIFTING: " + ", ".join(failed)))
+        lo = hi
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="what", required=True)
+    s = sub.add_parser("store")
+    s.add_argument("results")
+    a = sub.add_parser("approach")
+    a.add_argument("run")
+    a.add_argument("--window", type=float, default=10.0)
+    a.add_argument("--block", type=float, default=1.0)
+    a.add_argument("--z", type=float, default=3.0)
+    a.add_argument("--tolerance", type=float, default=0.05)
+    args = ap.parse_args()
+    if args.what == "store":
+        store(args.results)
+    else:
+        if not (args.window > 0 and args.block > 0 and args.z > 0 and args.tolerance > 0):
+            sys.exit("stationarity_check.py: --window, --block, --z and --tolerance must be > 0")
+        approach(args.run, args.window, args.block, args.z, args.tolerance)
+
+
+if __name__ == "__main__":
+    main()
