@@ -32,14 +32,13 @@ long count(const nlohmann::json& js, const char* key) {
 
 // The measured window's stationarity signals, one line, and what failed.
 std::string stationarity_text(const nlohmann::json& js) {
-  std::string out = fmt::format(
+  return fmt::format(
       "  stationarity of the window: net y drag {:.3g} +- {:.2g} P, mu_top - mu_bottom {:.3g} +- "
       "{:.2g}, H change {:.3g} +- {:.2g} d, bulk normal load {:.4f} +- {:.2g} P: {}\n",
       num(js, "net_drag_y"), num(js, "net_drag_y_err"), num(js, "mu_top_minus_bottom"),
       num(js, "mu_top_minus_bottom_err"), num(js, "H_change"), num(js, "H_change_err"),
       num(js, "bulk_normal_load"), num(js, "bulk_normal_load_err"),
       flag(js, "stationary") ? "stationary" : "DRIFTING");
-  return out;
 }
 
 }  // namespace

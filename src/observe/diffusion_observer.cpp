@@ -159,14 +159,14 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
     // The steady window's error bars and profiles from the frames (a run measures its profiles
     // every step; these are frame averages over the same window).
     const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
-    add_steady_errors(js, strain.value, series("H"), series("phi"), series("mu_top"),
-                      series("mu_bottom"), from, strain.value.back(), cfg.analysis.error_block);
+    const auto h = series("H"), mu_top = series("mu_top"), mu_bottom = series("mu_bottom");
+    add_steady_errors(js, strain.value, h, series("phi"), mu_top, mu_bottom, from,
+                      strain.value.back(), cfg.analysis.error_block);
     if (has_h5md_observable(traj, "net_drag_y"))
       add_stationarity(
-          js, pressure_cell_stationarity(cfg.steady, strain.value, series("H"), series("mu_top"),
-                                         series("mu_bottom"), series("net_drag_y"),
-                                         series("bulk_normal_load"), from, strain.value.back(),
-                                         cfg.analysis.error_block));
+          js, pressure_cell_stationarity(cfg.steady, strain.value, h, mu_top, mu_bottom,
+                                         series("net_drag_y"), series("bulk_normal_load"), from,
+                                         strain.value.back(), cfg.analysis.error_block));
     if (walls)
       profiles.to_summary(js, cfg.flow.j, height_sum / static_cast<double>(frames.size()),
                           cfg.observables.wall_exclusion);
