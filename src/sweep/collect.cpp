@@ -263,6 +263,9 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
       const std::string key = o.substr(0, eq);
       const bool is_axis = std::any_of(spec.axes.begin(), spec.axes.end(),
                                        [&](const auto& a) { return a.first == key; });
+      const bool is_paired = std::any_of(spec.paired.begin(), spec.paired.end(),
+                                         [&](const auto& pk) { return pk.key == key; });
+      if (is_paired) row["paired." + key] = o.substr(eq + 1);
       if (!is_axis) continue;
       row["axis." + key] = o.substr(eq + 1);
       if (key != "flow.J" && !is_seed_axis(key)) {
@@ -295,6 +298,7 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   // sweep.csv: fixed leading columns, then the axes, then every summary key.
   std::vector<std::string> columns = {"point", "status"};
   for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
+  for (const auto& pk : spec.paired) columns.push_back("paired." + pk.key);
   columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
   std::ostringstream csv;
   csv << fmt::format("{}\n", fmt::join(columns, ","));

@@ -83,7 +83,7 @@ SweepSpec load_sweep(const fs::path& file) {
   const auto* sweep = root["sweep"].as_table();
   if (!sweep) throw ConfigError(fmt::format("{}: missing the [sweep] table", origin));
   const std::string w = origin + ": sweep";
-  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes", "results"}, w);
+  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes", "paired", "results"}, w);
 
   const auto base = get_or<std::string>(*sweep, "base", "", w);
   if (base.empty()) throw ConfigError(fmt::format("{}.base: missing (the base config file)", w));
@@ -148,6 +148,58 @@ SweepSpec load_sweep(const fs::path& file) {
               where, j + 1, i + 1, values[j],
               values[i] == values[j] ? "" : " and " + values[i] + ", one directory name"));
     spec.axes.emplace_back(k, std::move(values));
+  }
+  // A key given both as a fixed value and as an axis has no single meaning: refuse it rather
+  // than let one silently win.
+  for (const auto& [k, v] : spec.set) {
+    (void)v;
+    for (const auto& axis : spec.axes)
+      if (axis.first == k)
+        throw ConfigError(fmt::format(
+            "{}.set.\"{}\": also an axis ({}.axes.\"{}\"); give it in one place", w, k, w, k));
+  }
+  if (const auto* node = sweep->get("paired")) {
+    const auto* paired = node->as_table();
+    if (!paired)
+      throw ConfigError(
+          fmt::format("{}.paired: must be a table of axes, e.g. [sweep.paired.\"flow.J\"] "
+                      "\"particles.phi_init\" = [0.74, 0.62]",
+                      w));
+    std::set<std::string> taken;
+    for (const auto& [ak, an] : *paired) {
+      const std::string axis_key(ak.str());
+      const std::string where = fmt::format("{}.paired.\"{}\"", w, axis_key);
+      const auto axis = std::find_if(spec.axes.begin(), spec.axes.end(),
+                                     [&](const auto& a) { return a.first == axis_key; });
+      if (axis == spec.axes.end())
+        throw ConfigError(fmt::format("{}: \"{}\" is not an axis of {}.axes", where, axis_key, w));
+      const auto* keys = an.as_table();
+      if (!keys || keys->empty())
+        throw ConfigError(fmt::format(
+            "{}: must be a table of keys, each a list of one value per entry of the axis", where));
+      for (const auto& [kk, kv] : *keys) {
+        const std::string key(kk.str());
+        const std::string wk = fmt::format("{}.\"{}\"", where, key);
+        const auto* arr = kv.as_array();
+        if (!arr || arr->size() != axis->second.size())
+          throw ConfigError(
+              fmt::format("{}: must be a list of {} values, one per entry of the axis", wk,
+                          axis->second.size()));
+        const bool in_axes = std::any_of(spec.axes.begin(), spec.axes.end(),
+                                         [&](const auto& a) { return a.first == key; });
+        const bool in_set = std::any_of(spec.set.begin(), spec.set.end(),
+                                        [&](const auto& s) { return s.first == key; });
+        if (in_axes || in_set || !taken.insert(key).second)
+          throw ConfigError(fmt::format("{}: the key is also {}; give it in one place", wk,
+                                        in_axes  ? "an axis"
+                                        : in_set ? "in [sweep.set]"
+                                                 : "paired with another axis"));
+        std::vector<std::string> values;
+        for (const auto& e : *arr) values.push_back(value_text(e, wk));
+        spec.paired.push_back(
+            {static_cast<std::size_t>(axis - spec.axes.begin()), key, std::move(values)});
+      }
+    }
   }
 
   if (const auto* s = root["slurm"].as_table()) {
@@ -216,6 +268,7 @@ std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
       p.overrides.push_back(key + "=" + values[at[a]]);
       parts.push_back(key.substr(key.rfind('.') + 1) + "=" + name_text(values[at[a]]));
     }
+    for (const auto& pk : spec.paired) p.overrides.push_back(pk.key + "=" + pk.values[at[pk.axis]]);
     p.name = fmt::format("{}", fmt::join(parts, "_"));
     points.push_back(std::move(p));
   }

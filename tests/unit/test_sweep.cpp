@@ -101,6 +101,50 @@ TEST(Sweep, BadSweepFilesNameTheKey) {
             std::string::npos);
 }
 
+// A key paired with an axis takes one value per entry of that axis (each J its own start), keeps
+// the point names, and a key given in two places is refused rather than one silently winning.
+TEST(Sweep, PairedValuesFollowTheirAxis) {
+  const auto file = write_files("paired", R"(
+[sweep]
+base = "base.toml"
+[sweep.axes]
+"flow.J" = [1e-2, 0.1]
+"run.seed" = [1, 2]
+[sweep.paired."flow.J"]
+"particles.phi_init" = [0.74, 0.62]
+)");
+  const auto spec = load_sweep(file);
+  const auto points = expand_points(spec);
+  ASSERT_EQ(points.size(), 4u);
+  EXPECT_EQ(points[1].name, "J=0.01_seed=2");
+  EXPECT_EQ(points[2].name, "J=0.1_seed=1");
+  EXPECT_DOUBLE_EQ(load_config(spec.base, points[1].overrides).particles.phi_init, 0.74);
+  EXPECT_DOUBLE_EQ(load_config(spec.base, points[2].overrides).particles.phi_init, 0.62);
+  EXPECT_DOUBLE_EQ(load_config(spec.base, points[3].overrides).flow.j, 0.1);
+
+  const std::string head =
+      "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n\"flow.J\" = [1e-2, 0.1]\n";
+  auto e = error_of(write_files(
+      "paired_len", head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7]\n"));
+  EXPECT_NE(e.find("sweep.paired.\"flow.J\".\"particles.phi_init\": must be a list of 2 values"),
+            std::string::npos)
+      << e;
+  e = error_of(write_files("paired_axis",
+                           head + "[sweep.paired.\"run.seed\"]\n\"particles.phi_init\" = [0.7]\n"));
+  EXPECT_NE(e.find("\"run.seed\" is not an axis"), std::string::npos) << e;
+  e = error_of(write_files("paired_set", head + "[sweep.set]\n\"particles.phi_init\" = 0.7\n"
+                                                "[sweep.paired.\"flow.J\"]\n"
+                                                "\"particles.phi_init\" = [0.7, 0.6]\n"));
+  EXPECT_NE(e.find("also in [sweep.set]"), std::string::npos) << e;
+  e = error_of(write_files("set_and_axis", head + "[sweep.set]\n\"flow.J\" = 0.3\n"));
+  EXPECT_NE(e.find("sweep.set.\"flow.J\": also an axis"), std::string::npos) << e;
+  // A bad paired value is found before anything runs, with the point's name.
+  e = error_of(write_files(
+      "paired_bad", head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7, 2.0]\n"));
+  EXPECT_NE(e.find("point J=0.1"), std::string::npos) << e;
+  EXPECT_NE(e.find("particles.phi_init"), std::string::npos) << e;
+}
+
 // Issue 16: equal axis values raced in one directory and counted twice in the fits; a
 // directory as the base config ran the default scene.
 TEST(Sweep, DuplicatePointsAndDirectoryBaseAreRefused) {

@@ -18,6 +18,15 @@ struct SweepSpec {
   // values kept as TOML text so that they reach the config parser exactly as --set would.
   std::vector<std::pair<std::string, std::string>> set;
   std::vector<std::pair<std::string, std::vector<std::string>>> axes;
+  // Keys whose value goes with an axis's entries, one value per entry, not an axis of their
+  // own ([sweep.paired."flow.J"], e.g. each J started near its own steady phi): the axis index,
+  // the key and its values. They do not enter the point names.
+  struct Paired {
+    std::size_t axis;
+    std::string key;
+    std::vector<std::string> values;
+  };
+  std::vector<Paired> paired;
   int jobs = 2;
   std::string backend = "local";
   // Optional: where finished points' small results persist (summary.json, config.toml,
