@@ -80,7 +80,9 @@ def main():
     window = None
     if h5py is not None and js:
         for r in rows:
-            f = args.sweep / "points" / r["point"] / "analysis.h5"
+            # A fit over several stores (`sheardiff fit`) names each point's store.
+            base = args.sweep / r["store"] if r.get("store") else args.sweep
+            f = base / "points" / r["point"].split("/")[-1] / "analysis.h5"
             if not f.exists():
                 continue
             with h5py.File(f, "r") as h:

@@ -112,8 +112,10 @@ def main():
         sys.exit(f"{out}: fits.json has no J fits (a sweep without a flow.J axis, such as "
                  f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
-    done = [r for r in rows if r["status"].startswith("done")]
-    cpu = sum(float(r["wall_seconds"]) for r in done if r.get("wall_seconds"))
+    # Measurements that enter the fits; every finished run counts for the cost.
+    done = [r for r in rows if r["status"] == "done"]
+    finished = [r for r in rows if r["status"].startswith("done")]
+    cpu = sum(float(r["wall_seconds"]) for r in finished if r.get("wall_seconds"))
     print(f"{fits['finished']} of {fits['points']} points finished; summed run time "
           f"{cpu / 3600:.2f} h.\n")
     for g in fits["groups"]:
@@ -161,7 +163,7 @@ def main():
         print()
         against_seed_laws(g["rows"])
     causes(done)
-    cost(done)
+    cost(finished)
     if len(fits["groups"]) == 1:
         subrange_fits(done)
 

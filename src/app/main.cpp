@@ -107,9 +107,9 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
 struct CommandLine {
   CommandLine();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
-  CLI::App *run, *check, *doc, *analyse, *sweep;
+  CLI::App *run, *check, *doc, *analyse, *sweep, *fit;
   std::string config_path, out_dir = "out", resume_dir, run_dir, sweep_file, backend;
-  std::vector<std::string> overrides;
+  std::vector<std::string> overrides, stores;
   bool overwrite = false, quiet = false, markdown = false, collect_only = false;
   double progress_seconds = 60.0;
   int jobs = 0;
@@ -186,6 +186,16 @@ CommandLine::CommandLine() {
                   "fits.json (what the Slurm collect job does)");
   sweep->add_flag("-q,--quiet", quiet,
                   "No progress lines; failures and the result's first line are still printed");
+
+  fit = app.add_subcommand(
+      "fit",
+      "Fit the seed's laws over the finished points of several stores or sweep folders as one "
+      "group: each J from the first listed that holds it, points that failed the stationarity "
+      "test left out; writes OUT/sweep.csv, OUT/fits.json (docs/sweeps.md)");
+  fit->add_option("stores", stores, "Stores (results/NAME) or sweep folders, in priority order")
+      ->required();
+  fit->add_option("--out", out_dir, "Folder for sweep.csv and fits.json (not a sweep's own)")
+      ->required();
 }
 
 // `sheardiff analyse DIR`: the diffusion analysis of a finished run, again.
@@ -340,6 +350,13 @@ int main(int argc, char** argv) {
     if (cl.sweep->parsed())
       return run_sweep(cl.sweep_file, cl.out_dir, cl.jobs, cl.backend, cl.point, cl.collect_only,
                        cl.quiet);
+    if (cl.fit->parsed()) {
+      std::vector<std::filesystem::path> stores(cl.stores.begin(), cl.stores.end());
+      const auto fits = sheardiff::fit_stores(stores, cl.out_dir);
+      fmt::print("fit: {} points used, J fits in {}/fits.json, every point in {}/sweep.csv\n",
+                 fits["finished"].get<long>(), cl.out_dir, cl.out_dir);
+      return 0;
+    }
     if (cl.check->parsed() && sheardiff::is_sweep_file(cl.config_path))
       return check_sweep_command(cl);
     return config_command(cl, dir);

@@ -2,6 +2,7 @@
 // seed's power laws per group of points that differ only in J and seed).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -35,6 +36,23 @@ std::string csv_cell(const json& v) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
+}
+
+// sweep.csv: one line of column names, then one line per row (empty cells where a row lacks
+// a column).
+std::string csv_text(const std::vector<std::string>& columns,
+                     const std::vector<std::map<std::string, json>>& table) {
+  std::ostringstream csv;
+  csv << fmt::format("{}\n", fmt::join(columns, ","));
+  for (const auto& row : table) {
+    std::vector<std::string> cells;
+    for (const auto& c : columns) {
+      auto it = row.find(c);
+      cells.push_back(it == row.end() ? "" : csv_cell(it->second));
+    }
+    csv << fmt::format("{}\n", fmt::join(cells, ","));
+  }
+  return csv.str();
 }
 
 // A summary flattened to scalars: arrays become key_0, key_1, ...
@@ -214,6 +232,64 @@ json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replic
   return out;
 }
 
+namespace {
+
+// One group's entry of fits.json: the runs averaged over seeds at each J, the seed's laws
+// fitted to the means, errors from the seed bootstrap.
+json fits_of_group(const std::map<double, std::vector<json>>& by_j, const json& axes) {
+  // Seeds averaged at each J (standard error of their mean where there are several).
+  std::vector<json> rows;
+  for (const auto& [j, runs] : by_j) {
+    json r{{"J", j}, {"runs", runs.size()}};
+    for (const char* q : {"phi", "mu", "D", "dv", "psi", "H"}) {
+      double s = 0, s2 = 0;
+      long n = 0;
+      for (const auto& run : runs) {
+        const double v = num(run, q);
+        if (!std::isfinite(v)) continue;
+        s += v;
+        s2 += v * v;
+        ++n;
+      }
+      if (n == 0) {
+        r[q] = nullptr;
+        continue;
+      }
+      const double mean = s / n;
+      r[q] = mean;
+      // The scatter between seeds (null with one seed), and what the runs' own error bars
+      // predict for it (their rms over sqrt(n)): the two agree if the error bars are right.
+      r[std::string(q) + "_sem"] =
+          n > 1 ? json(std::sqrt(std::max(0.0, (s2 - n * mean * mean) / (n - 1)) / n))
+                : json(nullptr);
+      double e2 = 0;
+      long ne = 0;
+      for (const auto& run : runs)
+        if (const double e = num(run, (std::string(q) + "_err").c_str()); std::isfinite(e))
+          e2 += e * e, ++ne;
+      r[std::string(q) + "_run_err"] =
+          ne > 0 ? json(std::sqrt(e2 / ne) / std::sqrt(static_cast<double>(ne))) : json(nullptr);
+    }
+    rows.push_back(r);
+  }
+  json laws = fit_group(rows);
+  // Quoted errors: the seed bootstrap's; the regressions' own stay as *_regression_stderr.
+  const json boot = seed_bootstrap(by_j, 2000);
+  for (auto& [name, f] : laws.items()) {
+    if (f.contains("error")) continue;
+    for (const char* q : {"a", "b", "phi_c", "mu_c"}) {
+      const std::string se = std::string(q) + "_stderr";
+      if (!f.contains(q)) continue;
+      if (f.contains(se)) f[std::string(q) + "_regression_stderr"] = f[se];
+      f[se] = boot.contains(name) && boot[name].contains(q) ? boot[name][q] : json(nullptr);
+    }
+    f["errors"] = boot.contains(name) ? "seed bootstrap" : "none: one seed per J";
+  }
+  return {{"axes", axes}, {"rows", rows}, {"fits", laws}};
+}
+
+}  // namespace
+
 json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   if (!fs::is_directory(out_dir / "points") &&
       (spec.results.empty() || !fs::is_directory(spec.results / "points")))
@@ -300,18 +376,8 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
   for (const auto& pk : spec.paired) columns.push_back("paired." + pk.key);
   columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
-  std::ostringstream csv;
-  csv << fmt::format("{}\n", fmt::join(columns, ","));
-  for (const auto& row : table) {
-    std::vector<std::string> cells;
-    for (const auto& c : columns) {
-      auto it = row.find(c);
-      cells.push_back(it == row.end() ? "" : csv_cell(it->second));
-    }
-    csv << fmt::format("{}\n", fmt::join(cells, ","));
-  }
   fs::create_directories(out_dir);
-  write_file_atomically(out_dir / "sweep.csv", csv.str());
+  write_file_atomically(out_dir / "sweep.csv", csv_text(columns, table));
   // The store's sweep.csv and fits.json stand for every point it holds: a sweep over a part of
   // them (one J, one seed, run on another machine) stores its points but leaves those two files
   // to a sweep that covers the whole store, instead of replacing them with fits over its part.
@@ -331,7 +397,7 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   }
   if (!spec.results.empty() && whole_store) {
     fs::create_directories(spec.results);
-    write_file_atomically(spec.results / "sweep.csv", csv.str());
+    write_file_atomically(spec.results / "sweep.csv", csv_text(columns, table));
   }
 
   json fits;
@@ -342,60 +408,141 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   // cases over seeds) has no J axis to fit and is not that paper's measurement.
   if (!groups.empty()) fits["seed_table1"] = seed_reference();
   fits["groups"] = json::array();
-  for (const auto& [key, by_j] : groups) {
-    // Seeds averaged at each J (standard error of their mean where there are several).
-    std::vector<json> rows;
-    for (const auto& [j, runs] : by_j) {
-      json r{{"J", j}, {"runs", runs.size()}};
-      for (const char* q : {"phi", "mu", "D", "dv", "psi", "H"}) {
-        double s = 0, s2 = 0;
-        long n = 0;
-        for (const auto& run : runs) {
-          const double v = num(run, q);
-          if (!std::isfinite(v)) continue;
-          s += v;
-          s2 += v * v;
-          ++n;
-        }
-        if (n == 0) {
-          r[q] = nullptr;
-          continue;
-        }
-        const double mean = s / n;
-        r[q] = mean;
-        // The scatter between seeds (null with one seed), and what the runs' own error bars
-        // predict for it (their rms over sqrt(n)): the two agree if the error bars are right.
-        r[std::string(q) + "_sem"] =
-            n > 1 ? json(std::sqrt(std::max(0.0, (s2 - n * mean * mean) / (n - 1)) / n))
-                  : json(nullptr);
-        double e2 = 0;
-        long ne = 0;
-        for (const auto& run : runs)
-          if (const double e = num(run, (std::string(q) + "_err").c_str()); std::isfinite(e))
-            e2 += e * e, ++ne;
-        r[std::string(q) + "_run_err"] =
-            ne > 0 ? json(std::sqrt(e2 / ne) / std::sqrt(static_cast<double>(ne))) : json(nullptr);
-      }
-      rows.push_back(r);
-    }
-    json group_fits = fit_group(rows);
-    // Quoted errors: the seed bootstrap's; the regressions' own stay as *_regression_stderr.
-    const json boot = seed_bootstrap(by_j, 2000);
-    for (auto& [name, f] : group_fits.items()) {
-      if (f.contains("error")) continue;
-      for (const char* q : {"a", "b", "phi_c", "mu_c"}) {
-        const std::string se = std::string(q) + "_stderr";
-        if (!f.contains(q)) continue;
-        if (f.contains(se)) f[std::string(q) + "_regression_stderr"] = f[se];
-        f[se] = boot.contains(name) && boot[name].contains(q) ? boot[name][q] : json(nullptr);
-      }
-      f["errors"] = boot.contains(name) ? "seed bootstrap" : "none: one seed per J";
-    }
-    fits["groups"].push_back({{"axes", group_axes[key]}, {"rows", rows}, {"fits", group_fits}});
-  }
+  for (const auto& [key, by_j] : groups)
+    fits["groups"].push_back(fits_of_group(by_j, group_axes[key]));
   write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
   if (!spec.results.empty() && whole_store)
     write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
+  return fits;
+}
+
+namespace {
+
+// Why a finished point's measurement is left out of a combined fit, or "" to keep it.
+std::string exclusion(const json& summary, double drift_z) {
+  if (summary.contains("steady") && summary["steady"].is_boolean() &&
+      !summary["steady"].get<bool>())
+    return "done, not steady";
+  if (summary.contains("stationary") && summary["stationary"].is_boolean())
+    return summary["stationary"].get<bool>() ? "" : "done, not stationary";
+  // Written before the stationarity test: of its signals only the walls' mu are stored. Their
+  // errors are combined as if independent (the difference's own noise is not stored).
+  const double d = num(summary, "mu_top") - num(summary, "mu_bottom");
+  const double e = std::hypot(num(summary, "mu_top_err"), num(summary, "mu_bottom_err"));
+  if (!std::isfinite(d) || !std::isfinite(e)) return "";  // no walls: nothing to judge by
+  return std::abs(d) > drift_z * e ? "done, drifting (mu_top - mu_bottom)" : "";
+}
+
+// What must agree between points fitted as one group (J and the seed vary; the start and the
+// run's length may).
+std::string group_identity(const Config& c) {
+  return fmt::format(
+      "scene {}, N = {}, mix {}, size ratio {}, ktilde = {}, kt/kn = {}, mu = {}, "
+      "delta = {}, aspect {}",
+      c.scene.type, c.particles.n, to_string(c.particles.mix), c.particles.size_ratio,
+      c.contact.ktilde, c.contact.kt_ratio, c.contact.mu, c.lubrication.delta, c.particles.aspect);
+}
+
+}  // namespace
+
+json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir) {
+  if (stores.empty()) throw ConfigError("fit: give at least one store");
+  if (fs::exists(out_dir / "points") ||
+      (fs::exists(out_dir / "fits.json") && !fs::exists(out_dir / "fit_sources.txt")))
+    throw ConfigError(fmt::format(
+        "fit --out {}: that folder holds a sweep or a store, whose sweep.csv and fits.json this "
+        "would replace; give a folder of its own",
+        out_dir.string()));
+  std::vector<std::map<std::string, json>> table;
+  std::set<std::string> summary_keys;
+  std::map<double, std::vector<json>> by_j;
+  std::map<double, std::string> j_from;  // each J's store
+  std::string identity, identity_of;
+  long used = 0;
+  // Stores are named relative to the output folder, so that a committed fit names no path
+  // outside the repository and still finds its points from anywhere.
+  fs::create_directories(out_dir);
+  const auto relative_name = [&](const fs::path& store) {
+    return fs::relative(fs::weakly_canonical(store), fs::weakly_canonical(out_dir)).string();
+  };
+  for (const auto& store : stores) {
+    if (!fs::is_directory(store / "points"))
+      throw ConfigError(
+          fmt::format("fit: {}: not a store or sweep folder (no points/)", store.string()));
+    std::vector<fs::path> dirs;
+    for (const auto& e : fs::directory_iterator(store / "points"))
+      if (fs::exists(e.path() / "summary.json") && fs::exists(e.path() / "config.toml"))
+        dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    std::set<double> js_here;
+    std::vector<std::pair<fs::path, json>> here;
+    for (const auto& dir : dirs) {
+      std::ifstream in(dir / "summary.json");
+      json summary;
+      try {
+        summary = json::parse(in);
+      } catch (const json::exception& e) {
+        throw ConfigError(fmt::format("fit: {}: not a valid summary: {}",
+                                      (dir / "summary.json").string(), e.what()));
+      }
+      if (!summary.contains("J") || !summary["J"].is_number()) continue;
+      js_here.insert(summary["J"].get<double>());
+      here.emplace_back(dir, std::move(summary));
+    }
+    for (auto& [dir, summary] : here) {
+      const Config cfg = load_config(dir / "config.toml");
+      const std::string id = group_identity(cfg);
+      const std::string name =
+          (store.filename().empty() ? store.parent_path().filename() : store.filename()).string() +
+          "/" + dir.filename().string();
+      if (identity.empty()) identity = id, identity_of = name;
+      if (id != identity)
+        throw ConfigError(fmt::format(
+            "fit: {} ({}) and {} ({}) are not one group: fit stores of the same physics", name, id,
+            identity_of, identity));
+      const double j = summary["J"].get<double>();
+      std::map<std::string, json> row;
+      row["point"] = name;
+      row["store"] = relative_name(store);
+      std::string status = "done";
+      if (const auto it = j_from.find(j); it != j_from.end())
+        status = "replaced by " + it->second;
+      else if (const auto why = exclusion(summary, cfg.steady.drift_z); !why.empty())
+        status = why;
+      row["status"] = status;
+      std::map<std::string, json> flat;
+      flatten(summary, flat);
+      for (auto& [k, v] : flat) {
+        summary_keys.insert(k);
+        row[k] = v;
+      }
+      if (status == "done") {
+        by_j[j].push_back(summary);
+        ++used;
+      }
+      table.push_back(std::move(row));
+    }
+    for (double j : js_here) j_from.emplace(j, relative_name(store));
+  }
+  std::vector<std::string> columns = {"point", "status", "store"};
+  columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
+
+  json fits;
+  fits["sweep"] = "combined";
+  fits["stores"] = json::array();
+  for (const auto& st : stores) fits["stores"].push_back(relative_name(st));
+  fits["points"] = table.size();
+  fits["finished"] = used;
+  fits["seed_table1"] = seed_reference();
+  fits["groups"] = json::array();
+  if (!by_j.empty()) fits["groups"].push_back(fits_of_group(by_j, json::object()));
+  std::string sources =
+      "Fitted by `sheardiff fit` from (relative to this folder; each J from the first that holds "
+      "it):\n";
+  for (const auto& st : stores) sources += relative_name(st) + "\n";
+  write_file_atomically(out_dir / "fit_sources.txt", sources);
+  write_file_atomically(out_dir / "sweep.csv", csv_text(columns, table));
+  write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
   return fits;
 }
 

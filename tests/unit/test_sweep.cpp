@@ -319,6 +319,76 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
   EXPECT_THROW(stored_point(spec, points[0]), ConfigError);
 }
 
+// A refit over two stores: the re-measured store (listed first) replaces the older one's J, a
+// point whose window failed the stationarity test is left out, and so is an older point whose
+// walls' mu differ beyond steady.drift_z (3) combined errors; the fits are the sweep's own.
+TEST(Sweep, FitOverStoresTakesEachJFromTheFirstAndDropsDriftingPoints) {
+  const auto old_file = write_files("fit_old",
+                                    "[sweep]\nbase = \"base.toml\"\nresults = \"old_store\"\n"
+                                    "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
+                                    "\"run.seed\" = [1, 2]\n");
+  const auto root = old_file.parent_path();
+  const auto old_spec = load_sweep(old_file);
+  for (const auto& p : expand_points(old_spec))
+    fake_finished(old_spec, p, root / "old_run", p.index % 2 ? 0.5 : -0.5);
+  collect_sweep(old_spec, root / "old_run");
+  // An older point without the verdict: walls' mu 0.1 apart with errors 0.02 (z = 3.5).
+  const auto drifting = old_spec.results / "points" / "J=0.001_seed=2" / "summary.json";
+  nlohmann::json s;
+  std::ifstream(drifting) >> s;
+  s["mu_top"] = 0.5, s["mu_bottom"] = 0.6, s["mu_top_err"] = 0.02, s["mu_bottom_err"] = 0.0;
+  std::ofstream(drifting) << s.dump();
+  const auto kept = old_spec.results / "points" / "J=0.001_seed=1" / "summary.json";
+  std::ifstream(kept) >> s;
+  s["mu_top"] = 0.5, s["mu_bottom"] = 0.55, s["mu_top_err"] = 0.02, s["mu_bottom_err"] = 0.0;
+  std::ofstream(kept) << s.dump();
+
+  std::ofstream(root / "new.toml") << "[sweep]\nbase = \"base.toml\"\nresults = \"new_store\"\n"
+                                      "[sweep.set]\n\"run.strain\" = 60.0\n"
+                                      "[sweep.axes]\n\"flow.J\" = [1e-2, 1e-1]\n"
+                                      "\"run.seed\" = [1, 2, 3]\n";
+  const auto new_spec = load_sweep(root / "new.toml");
+  for (const auto& p : expand_points(new_spec))
+    fake_finished(new_spec, p, root / "new_run", 0.3 * static_cast<double>(p.index % 3) - 0.3);
+  const auto unsteady = root / "new_run" / "points" / "J=0.1_seed=3" / "summary.json";
+  std::ifstream(unsteady) >> s;
+  s["stationary"] = false;
+  std::ofstream(unsteady) << s.dump();
+  collect_sweep(new_spec, root / "new_run");
+
+  const auto out = root / "table1";
+  const auto fits = fit_stores({new_spec.results, old_spec.results}, out);
+  // Used: old J = 1e-4 (2) and 1e-3 (1 of 2), new J = 1e-2 (3) and 1e-1 (2 of 3).
+  EXPECT_EQ(fits["finished"].get<long>(), 8);
+  EXPECT_EQ(fits["points"].get<long>(), 14);
+  std::map<double, long> runs;
+  for (const auto& r : fits["groups"][0]["rows"]) runs[r["J"].get<double>()] = r["runs"];
+  EXPECT_EQ(runs, (std::map<double, long>{{1e-4, 2}, {1e-3, 1}, {1e-2, 3}, {1e-1, 2}}));
+  std::ifstream csv(out / "sweep.csv");
+  const std::string text(std::istreambuf_iterator<char>(csv), {});
+  EXPECT_NE(text.find("old_store/J=0.01_seed=1,replaced by"), std::string::npos) << text;
+  EXPECT_NE(text.find("old_store/J=0.001_seed=2,\"done, drifting (mu_top - mu_bottom)\""),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("new_store/J=0.1_seed=3,\"done, not stationary\""), std::string::npos);
+  // Its own folder only: a store's or a sweep's fits are never replaced.
+  EXPECT_THROW(fit_stores({new_spec.results}, old_spec.results), ConfigError);
+  EXPECT_NO_THROW(fit_stores({new_spec.results}, out));  // its own earlier output
+  // Stores of other physics are not one group.
+  std::ofstream(root / "stiff.toml") << "[sweep]\nbase = \"base.toml\"\nresults = \"stiff\"\n"
+                                        "[sweep.set]\n\"contact.ktilde\" = 1e5\n"
+                                        "[sweep.axes]\n\"flow.J\" = [1e-3]\n";
+  const auto stiff = load_sweep(root / "stiff.toml");
+  for (const auto& p : expand_points(stiff)) fake_finished(stiff, p, root / "stiff_run", 0.0);
+  collect_sweep(stiff, root / "stiff_run");
+  try {
+    fit_stores({stiff.results, old_spec.results}, root / "mixed");
+    ADD_FAILURE() << "stores of two stiffnesses were fitted as one";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("not one group"), std::string::npos) << e.what();
+  }
+}
+
 // The seeds' bootstrap quotes the unbiased standard error even with two seeds per J. Three J
 // (1e-3, 1e-2, 1e-1) on an exact D = J^-1/4, two seeds each; only J = 0.1 scatters, by
 // D (1 +- eps). The log-log slope through three equally spaced points is (y_3 - y_1) / 2, so its

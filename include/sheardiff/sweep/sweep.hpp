@@ -101,6 +101,16 @@ std::filesystem::path stored_point(const SweepSpec& spec, const SweepPoint& p);
 // DIR/fits.json (atomically; also into spec.results). Returns fits.json.
 nlohmann::json collect_sweep(const SweepSpec& spec, const std::filesystem::path& out_dir);
 
+// The seed's laws fitted over the finished points of several stores or sweep folders, as one
+// group (same N, ktilde, mixing, ...; refused otherwise): each J is taken from the first store
+// that holds a point at it, so a re-measured store listed first replaces an older one's J.
+// Points whose measured window failed the stationarity test are left out, and so are older
+// points (written before that test) whose mu_top - mu_bottom exceeds steady.drift_z combined
+// errors. Writes out_dir/sweep.csv (every point with its status and store), out_dir/fits.json
+// and out_dir/fit_sources.txt; refuses a folder holding a sweep or a store. Returns fits.json.
+nlohmann::json fit_stores(const std::vector<std::filesystem::path>& stores,
+                          const std::filesystem::path& out_dir);
+
 // The fits of one group of runs (same ktilde, N, ...): power laws of D, dv, Psi against J and
 // against phi_c - phi, phi(J) = phi_c - a J^b and mu(J) = mu_c + a J^b. rows: one per J, keys
 // J, phi, mu, D, dv, psi (seeds already averaged). Fits that lack points hold {"error": why}.
