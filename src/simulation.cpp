@@ -241,18 +241,60 @@ nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& 
   return run_to_directory(cfg, dir, resume ? RunMode::resume : RunMode::start, progress);
 }
 
+std::string restart_would_lose(const RunDirectory& dir, const Config& cfg) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir.file("summary.json"), ec) || fs::exists(dir.file("checkpoint.bin"), ec))
+    return {};
+  std::vector<std::string> kept;
+  for (const char* name : {"analysis.h5", "channel.h5"})
+    if (fs::exists(dir.file(name), ec))
+      kept.push_back(fmt::format("{} (written when a run finishes)", name));
+  const auto traj = dir.file("trajectory.h5");
+  if (cfg.output.checkpoint_strain > 0 && fs::exists(traj, ec)) {
+    // A start killed before its first checkpoint has frames up to about that strain (one more
+    // frame may have reached the disk before the checkpoint did). A file too damaged to read is
+    // such a start's (an unclosed file): it holds nothing to keep.
+    try {
+      if (has_h5md_observable(traj, "strain")) {
+        const auto strain = read_h5md_observable(traj, "strain").value;
+        const std::size_t n = strain.size();
+        const double spacing = n >= 2 ? strain[n - 1] - strain[n - 2] : 0.0;
+        if (n > 0 && strain.back() > cfg.output.checkpoint_strain + 1.5 * spacing + 1e-9)
+          kept.push_back(
+              fmt::format("trajectory.h5 ({} frames up to strain {:.4g}, past the "
+                          "first checkpoint's {:.4g})",
+                          n, strain.back(), cfg.output.checkpoint_strain));
+      }
+    } catch (const std::exception&) {
+    }
+  }
+  if (kept.empty()) return {};
+  return fmt::format(
+      "{} holds {} but neither checkpoint.bin nor summary.json: the run got past its first "
+      "checkpoint, and those files were removed or moved since. Nothing was changed. Without "
+      "its checkpoint it cannot be continued, and starting again from strain 0 would delete "
+      "what is there: put checkpoint.bin (or summary.json) back, or copy what you need and "
+      "start again with --overwrite",
+      dir.path().string(), fmt::join(kept, " and "));
+}
+
 namespace {
 
 // What DIR holds decides what may be done (docs/stability.md, "Run directories"); nothing is
 // changed here. Returns whether the run continues from DIR's checkpoint; throws ConfigError for
 // a refused command.
-bool check_directory(RunDirectory& dir, RunMode mode, const std::string& resolved) {
+bool check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
+                     const std::string& resolved) {
   const std::string out = dir.path().string();
   const RunState state = dir.state();
   if (mode == RunMode::start && state != RunState::empty) throw ConfigError(refusal(dir));
   if (mode == RunMode::resume) {
     if (state == RunState::empty)
       throw ConfigError(fmt::format("--resume {}: there is no run there to resume", out));
+    if (state == RunState::started)
+      if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
+        throw ConfigError("--resume " + lost);
     if (std::filesystem::exists(dir.file("config.toml")) &&
         !same_config(dir.file("config.toml"), resolved))
       throw ConfigError(fmt::format(
@@ -341,7 +383,7 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   Config cfg = given;
   resolve_defaults(cfg);
   const std::string resolved = to_toml(cfg);
-  const bool from_checkpoint = check_directory(dir, mode, resolved);
+  const bool from_checkpoint = check_directory(dir, mode, cfg, resolved);
   if (mode == RunMode::resume && dir.state() == RunState::finished)
     return finished_run_summary(dir);
   const CheckpointStore checkpoints(dir.file("checkpoint.bin"), resolved, dir.path().string());

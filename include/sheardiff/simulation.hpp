@@ -74,7 +74,8 @@ class RunDirectory;
 //   start      DIR must hold no run;
 //   overwrite  the run files of any earlier run are removed first;
 //   resume     continue DIR's run: from its checkpoint; from strain 0 if it stopped before
-//              its first one; a finished run is left as it is (its checkpoint, if a death
+//              its first one (refused when DIR holds more than such a start leaves:
+//              restart_would_lose); a finished run is left as it is (its checkpoint, if a death
 //              left one behind, removed) and its summary returned.
 enum class RunMode { start, overwrite, resume };
 
@@ -90,6 +91,13 @@ enum class RunMode { start, overwrite, resume };
 // timestamp every progress_seconds; run.log gets those timestamped lines in any case.
 nlohmann::json run_to_directory(const Config& cfg, RunDirectory& dir, RunMode mode, bool progress,
                                 double progress_seconds = 60.0);
+// What a restart from strain 0 would delete in DIR when it holds neither checkpoint.bin nor
+// summary.json: an analysis written at a run's end, or frames past the first checkpoint's
+// strain (the checkpoint or the summary of a run that got further was removed). Returns the
+// refusal to print, naming what is there and what the user can do, or "" when DIR holds only
+// the remains of a start killed before its first checkpoint (or a finished/interrupted run).
+std::string restart_would_lose(const RunDirectory& dir, const Config& cfg);
+
 // The same in a RunDirectory of its own: resume ? RunMode::resume : RunMode::start.
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume = false);

@@ -63,6 +63,10 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_d
   // in it can be continued, and a stale trajectory must not survive into the new run
   // (overwrite removes it, under the run directory's own lock).
   RunDirectory dir(point_dir(out_dir, p), true);
+  // ... unless it holds what such a start cannot have left: its summary or checkpoint was moved.
+  if (state == PointState::fresh)
+    if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
+      throw ConfigError("sweep point " + p.name + ": " + lost);
   run_to_directory(cfg, dir, state == PointState::resumable ? RunMode::resume : RunMode::overwrite,
                    true);
   export_point(spec, p, out_dir);

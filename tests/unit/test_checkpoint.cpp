@@ -18,6 +18,7 @@
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/simulation.hpp"
 #include "sheardiff/version.hpp"
@@ -217,6 +218,37 @@ void make_interrupted_run(const fs::path& cfg, const fs::path& dir) {
   kill(pid, SIGTERM);
   ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
   ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+}
+
+// A finished run whose summary.json was deleted, or one whose checkpoint.bin was, looked like a
+// start killed before its first checkpoint: --resume deleted its analysis and rewrote its whole
+// trajectory from strain 0. It must be refused (exit 2) with every file left as it was.
+TEST(Checkpoint, ResumeNeverRestartsARunThatGotPastItsFirstCheckpoint) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_lost_summary";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  const fs::path dir = root / "run";
+  ASSERT_EQ(wait_exit(spawn(cfg, dir)), 0);
+  fs::remove(dir / "summary.json");
+  const auto trajectory = bytes_of(dir / "trajectory.h5");
+  const auto analysis = bytes_of(dir / "analysis.h5");
+  const fs::path err = root / "err.txt";
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, dir, {}, err)), 2);
+  const std::string message = text_of(err);
+  EXPECT_NE(message.find("neither checkpoint.bin nor summary.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("analysis.h5"), std::string::npos) << message;
+  EXPECT_NE(message.find("--overwrite"), std::string::npos) << message;
+  EXPECT_EQ(bytes_of(dir / "trajectory.h5"), trajectory);
+  EXPECT_EQ(bytes_of(dir / "analysis.h5"), analysis);
+  // Without the analysis either, its frames past the first checkpoint (strain 0.1 of 2) say it.
+  fs::remove(dir / "analysis.h5");
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, dir, {}, err)), 2);
+  EXPECT_NE(text_of(err).find("past the first checkpoint"), std::string::npos) << text_of(err);
+  EXPECT_EQ(bytes_of(dir / "trajectory.h5"), trajectory);
+  // A sweep asks the same question of a point directory before it starts one afresh.
+  RunDirectory held(dir, false);
+  EXPECT_NE(restart_would_lose(held, load_config(cfg)), "");
+  fs::remove_all(root);
 }
 
 // Issue 16: a flipped mantissa byte resumed to exit 0 with other results, a flipped exponent
