@@ -113,7 +113,10 @@ def main():
                  f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
     # Measurements that enter the fits; every finished run counts for the cost.
-    done = [r for r in rows if r["status"] == "done"]
+    # (`sheardiff fit --include-not-stationary` fits the flagged windows too: so does this.)
+    flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
+    done = [r for r in rows if r["status"] == "done"
+            or (fits.get("includes_not_stationary") and r["status"] in flagged)]
     finished = [r for r in rows if r["status"].startswith("done")]
     cpu = sum(float(r["wall_seconds"]) for r in finished if r.get("wall_seconds"))
     print(f"{fits['finished']} of {fits['points']} points finished; summed run time "

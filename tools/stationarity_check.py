@@ -23,6 +23,9 @@ import sys
 import numpy as np
 
 
+SIGNALS = ("net_drag_y", "mu_top_minus_bottom", "H_change", "bulk_normal_load")
+
+
 def store(path):
     rows = []
     for f in sorted(glob.glob(os.path.join(path, "points", "*", "summary.json"))):
@@ -30,7 +33,11 @@ def store(path):
         name = os.path.basename(os.path.dirname(f))
         if "stationary" in s:
             verdict = "stationary" if s["stationary"] else "DRIFTING: " + s.get("not_stationary", "")
-            rows.append((s.get("J", math.nan), name, verdict))
+            signals = " | ".join(
+                "{:+.3f} +- {:.3f}".format(s[k], s[k + "_err"]) if k in s and k + "_err" in s
+                else "-" for k in SIGNALS)
+            rows.append((s.get("J", math.nan), name,
+                         "| {:.4f} | {} | {}".format(s.get("phi", math.nan), signals, verdict)))
             continue
         if not all(k in s for k in ("mu_top", "mu_bottom", "mu_top_err", "mu_bottom_err")):
             rows.append((s.get("J", math.nan), name, "no verdict: no steady window"))
@@ -41,6 +48,8 @@ def store(path):
         verdict = "mu_top - mu_bottom = {:+.3f} +- {:.3f} (z = {:+.1f}): {}".format(
             d, e, z, "within noise" if abs(z) <= 3 else "DRIFTING")
         rows.append((s.get("J", math.nan), name, verdict + " (only signal stored)"))
+    print("point | phi | " + " | ".join(SIGNALS) + " | verdict   (signals: window means +- "
+          "their standard errors; the old summaries hold only the walls' mu)")
     for _, name, verdict in sorted(rows):
         print(f"{name:28s} {verdict}")
 

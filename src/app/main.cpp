@@ -110,7 +110,8 @@ struct CommandLine {
   CLI::App *run, *check, *doc, *analyse, *sweep, *fit;
   std::string config_path, out_dir = "out", resume_dir, run_dir, sweep_file, backend;
   std::vector<std::string> overrides, stores;
-  bool overwrite = false, quiet = false, markdown = false, collect_only = false;
+  bool overwrite = false, quiet = false, markdown = false, collect_only = false,
+       include_drifting = false;
   double progress_seconds = 60.0;
   int jobs = 0;
   long point = -1;
@@ -196,6 +197,9 @@ CommandLine::CommandLine() {
       ->required();
   fit->add_option("--out", out_dir, "Folder for sweep.csv and fits.json (not a sweep's own)")
       ->required();
+  fit->add_flag("--include-not-stationary", include_drifting,
+                "Fit the points flagged by the stationarity test too (a sensitivity check; "
+                "fits.json says so)");
 }
 
 // `sheardiff analyse DIR`: the diffusion analysis of a finished run, again.
@@ -352,7 +356,7 @@ int main(int argc, char** argv) {
                        cl.quiet);
     if (cl.fit->parsed()) {
       std::vector<std::filesystem::path> stores(cl.stores.begin(), cl.stores.end());
-      const auto fits = sheardiff::fit_stores(stores, cl.out_dir);
+      const auto fits = sheardiff::fit_stores(stores, cl.out_dir, cl.include_drifting);
       fmt::print("fit: {} points used, J fits in {}/fits.json, every point in {}/sweep.csv\n",
                  fits["finished"].get<long>(), cl.out_dir, cl.out_dir);
       return 0;

@@ -445,7 +445,8 @@ std::string group_identity(const Config& c) {
 
 }  // namespace
 
-json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir) {
+json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
+                bool include_drifting) {
   if (stores.empty()) throw ConfigError("fit: give at least one store");
   if (fs::exists(out_dir / "points") ||
       (fs::exists(out_dir / "fits.json") && !fs::exists(out_dir / "fit_sources.txt")))
@@ -516,7 +517,10 @@ json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir) {
         summary_keys.insert(k);
         row[k] = v;
       }
-      if (status == "done") {
+      // On request, windows flagged by the stationarity test enter the fits too (a check of
+      // how much the flagged points move them); replaced and unsteady points never do.
+      const bool flagged = status == "done, not stationary" || status.starts_with("done, drifting");
+      if (status == "done" || (include_drifting && flagged)) {
         by_j[j].push_back(summary);
         ++used;
       }
@@ -529,6 +533,7 @@ json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir) {
 
   json fits;
   fits["sweep"] = "combined";
+  fits["includes_not_stationary"] = include_drifting;
   fits["stores"] = json::array();
   for (const auto& st : stores) fits["stores"].push_back(relative_name(st));
   fits["points"] = table.size();

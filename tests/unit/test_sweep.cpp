@@ -371,6 +371,10 @@ TEST(Sweep, FitOverStoresTakesEachJFromTheFirstAndDropsDriftingPoints) {
             std::string::npos)
       << text;
   EXPECT_NE(text.find("new_store/J=0.1_seed=3,\"done, not stationary\""), std::string::npos);
+  // As a sensitivity check the flagged points can enter the fits: 2 more, the replaced never.
+  const auto all = fit_stores({new_spec.results, old_spec.results}, root / "table1_all", true);
+  EXPECT_EQ(all["finished"].get<long>(), 10);
+  EXPECT_TRUE(all["includes_not_stationary"].get<bool>());
   // Its own folder only: a store's or a sweep's fits are never replaced.
   EXPECT_THROW(fit_stores({new_spec.results}, old_spec.results), ConfigError);
   EXPECT_NO_THROW(fit_stores({new_spec.results}, out));  // its own earlier output

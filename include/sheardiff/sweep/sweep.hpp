@@ -108,8 +108,10 @@ nlohmann::json collect_sweep(const SweepSpec& spec, const std::filesystem::path&
 // points (written before that test) whose mu_top - mu_bottom exceeds steady.drift_z combined
 // errors. Writes out_dir/sweep.csv (every point with its status and store), out_dir/fits.json
 // and out_dir/fit_sources.txt; refuses a folder holding a sweep or a store. Returns fits.json.
+// include_drifting: points flagged by the stationarity test enter the fits as well (a
+// sensitivity check, recorded in fits.json as includes_not_stationary).
 nlohmann::json fit_stores(const std::vector<std::filesystem::path>& stores,
-                          const std::filesystem::path& out_dir);
+                          const std::filesystem::path& out_dir, bool include_drifting = false);
 
 // The fits of one group of runs (same ktilde, N, ...): power laws of D, dv, Psi against J and
 // against phi_c - phi, phi(J) = phi_c - a J^b and mu(J) = mu_c + a J^b. rows: one per J, keys
