@@ -72,6 +72,18 @@ void flatten(const json& summary, std::map<std::string, json>& row) {
   }
 }
 
+// The status of a finished run whose measurement cannot be fitted, or "" if it can: a pressure
+// cell that never reached steady state has no phi(J) or mu(J), and one whose measured window
+// drifted (or was too short to judge) measured a transient.
+std::string window_verdict(const json& summary) {
+  const auto is_false = [&](const char* key) {
+    return summary.contains(key) && summary[key].is_boolean() && !summary[key].get<bool>();
+  };
+  if (is_false("steady")) return "done, not steady";
+  if (is_false("stationary")) return "done, not stationary";
+  return "";
+}
+
 double num(const json& s, const char* key) {
   if (!s.contains(key) || !s[key].is_number()) return NAN;
   return s[key].get<double>();
@@ -356,15 +368,9 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
         summary_keys.insert(k);
         row[k] = v;
       }
-      // A pressure-cell run that never reached steady state has no phi(J) or mu(J) to fit.
-      const bool unsteady = summary.contains("steady") && !summary["steady"].get<bool>();
-      // One whose measured window drifted (or was too short to judge) measured a transient.
-      const bool drifting = !unsteady && summary.contains("stationary") &&
-                            summary["stationary"].is_boolean() &&
-                            !summary["stationary"].get<bool>();
-      if (unsteady) row["status"] = "done, not steady";
-      if (drifting) row["status"] = "done, not stationary";
-      if (summary.contains("J") && !unsteady && !drifting)
+      const std::string verdict = window_verdict(summary);
+      if (!verdict.empty()) row["status"] = verdict;
+      if (summary.contains("J") && verdict.empty())
         groups[group_key][summary["J"].get<double>()].push_back(summary);
       group_axes[group_key] = axes;
     }
@@ -420,11 +426,8 @@ namespace {
 
 // Why a finished point's measurement is left out of a combined fit, or "" to keep it.
 std::string exclusion(const json& summary, double drift_z) {
-  if (summary.contains("steady") && summary["steady"].is_boolean() &&
-      !summary["steady"].get<bool>())
-    return "done, not steady";
-  if (summary.contains("stationary") && summary["stationary"].is_boolean())
-    return summary["stationary"].get<bool>() ? "" : "done, not stationary";
+  if (const auto verdict = window_verdict(summary); !verdict.empty()) return verdict;
+  if (summary.contains("stationary")) return "";
   // Written before the stationarity test: of its signals only the walls' mu are stored. Their
   // errors are combined as if independent (the difference's own noise is not stored).
   const double d = num(summary, "mu_top") - num(summary, "mu_bottom");
