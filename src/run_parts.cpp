@@ -137,7 +137,8 @@ void TrajectoryOutput::close() {
 // The whole evolving state of the run, in one fixed order for saving and loading.
 // with_counters: version 3 checkpoints also hold the solver's work counters, and after them
 // the run's start time (absent from those of a sheardiff before it: then unknown).
-void CheckpointStore::serialize(Archive& a, RunningState& run, bool with_counters) const {
+void CheckpointStore::serialize(Archive& a, RunningState& run, int layout) const {
+  const bool with_counters = layout >= 3;
   std::string config = resolved_;
   a.io(config);
   if (!same_config_text(config, resolved_))
@@ -146,7 +147,7 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, bool with_counter
         "(see {}/config.toml)",
         out_, out_));
   Dynamics& d = run.dynamics();
-  d.serialize(a);
+  d.serialize(a, layout >= 5);
   run.sim.serialize_integrator(a);
   for (auto& o : run.observers) o->serialize(a);
   run.health.serialize(a);
@@ -175,7 +176,7 @@ void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
             file_.string(), payload.layout, out_));
   Archive a = Archive::reader(std::move(payload.bytes));
   try {
-    serialize(a, run, payload.layout >= 3);
+    serialize(a, run, payload.layout);
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {
@@ -190,7 +191,7 @@ void CheckpointStore::save(RunningState& run, double elapsed_now,
   Archive a = Archive::writer();
   double total = run.elapsed_before + elapsed_now;
   std::swap(total, run.elapsed_before);
-  serialize(a, run, true);
+  serialize(a, run, CheckpointPayload{}.layout);
   std::swap(total, run.elapsed_before);
   // Whole or absent: a checkpoint is never half-written.
   const std::vector<char> bytes = checkpoint_file_bytes(a.bytes());

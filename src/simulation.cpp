@@ -250,6 +250,8 @@ std::string restart_would_lose(const RunDirectory& dir, const Config& cfg) {
   for (const char* name : {"analysis.h5", "channel.h5"})
     if (fs::exists(dir.file(name), ec))
       kept.push_back(fmt::format("{} (written when a run finishes)", name));
+  if (fs::exists(dir.file("reanalysis"), ec))
+    kept.push_back("reanalysis/ (written by analyse on a finished run)");
   const auto traj = dir.file("trajectory.h5");
   if (cfg.output.checkpoint_strain > 0 && fs::exists(traj, ec)) {
     // A start killed before its first checkpoint has frames up to about that strain (one more
@@ -338,7 +340,15 @@ void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool
                  "%s: no checkpoint was written before the run stopped: starting again "
                  "from strain 0\n",
                  dir.path().c_str());
-  if (!from_checkpoint) write_file_atomically(dir.file("config.toml"), resolved);
+  if (!from_checkpoint) {
+    write_file_atomically(dir.file("config.toml"), resolved);
+  } else if (!std::filesystem::exists(dir.file("config.toml"))) {
+    // The checkpoint holds the run's config and has been checked against this one: a deleted
+    // config.toml is written again, so that the finished run can be analysed and swept.
+    write_file_atomically(dir.file("config.toml"), resolved);
+    std::fprintf(stderr, "%s was missing: written again (the checkpoint's configuration)\n",
+                 dir.file("config.toml").c_str());
+  }
 }
 
 // The end of the run. Every write replaces what an earlier attempt may have written (tables,
@@ -454,6 +464,13 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   if (!dir.logging()) throw;
   dir.remove_partial_files();
   const std::string out = dir.path().string();
+  if (dir.moved())
+    throw IoError(fmt::format(
+        "{}. {} was moved or removed while the run ran; {}", e.what(), out,
+        dir.state() == RunState::interrupted
+            ? "its checkpoint.bin went with it: continue with `sheardiff run CONFIG --resume "
+              "NEWDIR` where it is now"
+            : "no checkpoint had been written: start the run again"));
   throw IoError(fmt::format(
       "{}. {}", e.what(),
       dir.state() == RunState::interrupted

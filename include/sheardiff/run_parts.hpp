@@ -74,7 +74,7 @@ class CheckpointStore {
   const std::filesystem::path& file() const { return file_; }
 
  private:
-  void serialize(Archive& a, RunningState& run, bool with_counters) const;
+  void serialize(Archive& a, RunningState& run, int layout) const;
   std::filesystem::path file_;
   std::string resolved_, out_;
 };

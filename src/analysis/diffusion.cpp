@@ -163,22 +163,28 @@ void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
 }
 
 void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& file) {
-  // Written under a temporary name and renamed, so a complete-looking file is complete.
+  // Written under a temporary name and renamed, so a complete-looking file is complete; a
+  // failed write (a full disk) removes the temporary file.
   const auto tmp = file.string() + ".tmp";
-  {
-    H5Id f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
-    if (f.id < 0) throw std::runtime_error("cannot create " + tmp);
-    write_vector(f.id, "/msd/lag", r.msd.lag);
-    write_vector(f.id, "/msd/msd", r.msd.msd);
-    write_vector(f.id, "/msd/samples",
+  const auto fail = [&](const std::string& what) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(fmt::format("cannot {} {}", what, file.string()));
+  };
+  const hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (f < 0) fail("create");
+  try {
+    write_vector(f, "/msd/lag", r.msd.lag);
+    write_vector(f, "/msd/msd", r.msd.msd);
+    write_vector(f, "/msd/samples",
                  std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()));
-    write_vector(f.id, "/vacf/lag", r.vacf.lag);
-    write_vector(f.id, "/vacf/c", r.vacf.c);
+    write_vector(f, "/vacf/lag", r.vacf.lag);
+    write_vector(f, "/vacf/c", r.vacf.c);
     if (r.has_bulk) {
-      write_vector(f.id, "/msd/msd_bulk", r.msd_bulk.msd);
-      write_vector(f.id, "/vacf/c_bulk", r.vel_bulk.c.c);
+      write_vector(f, "/msd/msd_bulk", r.msd_bulk.msd);
+      write_vector(f, "/vacf/c_bulk", r.vel_bulk.c.c);
     }
-    H5Id root{H5Gopen2(f.id, "/", H5P_DEFAULT), H5Gclose};
+    H5Id root{H5Gopen2(f, "/", H5P_DEFAULT), H5Gclose};
     write_attribute(root.id, "D", r.fit.d);
     write_attribute(root.id, "D_err", r.d_error.err);
     write_attribute(root.id, "D_regression_stderr", r.fit.d_stderr);
@@ -195,7 +201,12 @@ void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& 
     write_attribute(root.id, "dv_err", r.vel.dv_err);
     write_attribute(root.id, "step_length", r.step_length);
     write_attribute(root.id, "frame_strain", r.frame_strain);
+    if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw std::runtime_error("flush");
+  } catch (const std::exception&) {
+    H5Fclose(f);
+    fail("write");
   }
+  if (H5Fclose(f) < 0) fail("write");
   std::filesystem::rename(tmp, file);
 }
 

@@ -1,11 +1,15 @@
 // Command line of sheardiff: run a config, validate one, analyse a run, run a sweep, or print
 // the config reference. What a finished run or analysis prints is in result_text.cpp.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -48,8 +52,18 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
     std::filesystem::create_directories(out / "logs");
     std::filesystem::remove(marker);
     try {
-      sd::run_point(spec, p, out);
+      // The point's result, as `run` prints it: into the pool's logs/<point>.log (this worker's
+      // output) and the point's run.log.
+      sd::run_point(spec, p, out, [&](const sd::RunDirectory&, const nlohmann::json& summary) {
+        const std::string dir = sd::point_dir(out, p).string();
+        fmt::print("{}{}", sd::run_result_first_line(summary, dir),
+                   sd::run_result_details(summary));
+        sd::print_warnings(summary);
+        std::fflush(stdout);
+      });
       return 0;
+    } catch (const sd::PointBusy&) {
+      throw;  // not a failure of the point: no marker
     } catch (const sd::RunInterrupted&) {
       throw;
     } catch (const std::exception& e) {
@@ -103,6 +117,35 @@ int run_sweep(const std::string& file, const std::filesystem::path& out, int job
   return 0;
 }
 
+// --out of every subcommand: a folder of its own, never "" or a filesystem root ("/" as root
+// would spread a run's files over the system).
+const CLI::Validator kOutFolder(
+    [](std::string& s) -> std::string {
+      if (s.empty()) return "an empty path; give the output folder";
+      std::error_code ec;
+      const auto p = std::filesystem::weakly_canonical(std::filesystem::absolute(s, ec), ec);
+      if (!ec && p == p.root_path())
+        return fmt::format("{} is a filesystem root; give a folder of its own", s);
+      return {};
+    },
+    "FOLDER");
+
+// Seconds: a finite number above 0 (CLI::PositiveNumber lets "nan" and "inf" through).
+const CLI::Validator kPositiveFinite(
+    [](std::string& s) -> std::string {
+      double v = 0.0;
+      try {
+        std::size_t used = 0;
+        v = std::stod(s, &used);
+        if (used != s.size()) return fmt::format("{}: not a number", s);
+      } catch (const std::exception&) {
+        return fmt::format("{}: not a number", s);
+      }
+      return std::isfinite(v) && v > 0.0 ? std::string()
+                                         : fmt::format("{}: must be a finite number > 0", s);
+    },
+    "SECONDS > 0");
+
 // Every subcommand and option of the command line.
 struct CommandLine {
   CommandLine();
@@ -129,7 +172,8 @@ CommandLine::CommandLine() {
       run->add_option("--out", out_dir,
                       "Output folder: trajectory.h5 (H5MD), summary.json, config.toml, "
                       "run.log. A folder holding a run is refused (see --resume, --overwrite)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(kOutFolder);
   run->add_option("--set", overrides,
                   "Override one key, section.key=value (repeatable), e.g. --set flow.J=1e-3");
   auto* resume_opt = run->add_option(
@@ -150,7 +194,7 @@ CommandLine::CommandLine() {
                   "Seconds between the timestamped progress lines written off a terminal and "
                   "to DIR/run.log")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(kPositiveFinite);
 
   check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
@@ -175,7 +219,7 @@ CommandLine::CommandLine() {
       "run directory DIR/points/NAME, skipping finished points and resuming "
       "interrupted ones, then write DIR/sweep.csv and DIR/fits.json (docs/sweeps.md)");
   sweep->add_option("sweep_file", sweep_file, "Sweep file (TOML)")->required();
-  sweep->add_option("--out", out_dir, "Sweep folder")->required();
+  sweep->add_option("--out", out_dir, "Sweep folder")->required()->check(kOutFolder);
   sweep->add_option("--jobs", jobs, "Worker processes (local backend; default sweep.jobs)")
       ->check(CLI::Range(1, 256));
   sweep->add_option("--backend", backend, "local or slurm (default sweep.backend)")
@@ -196,7 +240,8 @@ CommandLine::CommandLine() {
   fit->add_option("stores", stores, "Stores (results/NAME) or sweep folders, in priority order")
       ->required();
   fit->add_option("--out", out_dir, "Folder for sweep.csv and fits.json (not a sweep's own)")
-      ->required();
+      ->required()
+      ->check(kOutFolder);
   fit->add_flag("--include-not-stationary", include_drifting,
                 "Fit the points flagged by the stationarity test too (a sensitivity check; "
                 "fits.json says so)");
@@ -229,15 +274,21 @@ int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory
         run_dir));
   dir->start_log(sheardiff::this_command_line());
   dir->remove_partial_files();  // of an earlier analyse killed while writing
-  nlohmann::json js;
-  dir->with_hdf5_reasons([&] { js = sheardiff::reanalyse_run(run_dir); });
-  // Its writer does not check the file's close: a full disk leaves it truncated.
-  if (!sheardiff::hdf5_file_opens(dir->file("analysis.h5")))
-    throw sheardiff::IoError(fmt::format("cannot write {}: {}", dir->file("analysis.h5").string(),
+  sheardiff::Reanalysis re;
+  dir->with_hdf5_reasons([&] { re = sheardiff::reanalyse_run(run_dir); });
+  const auto h5 = re.folder / "analysis.h5";
+  if (std::filesystem::exists(h5) && !sheardiff::hdf5_file_opens(h5))
+    throw sheardiff::IoError(fmt::format("cannot write {}: {}", h5.string(),
                                          dir->hdf5_log()->last_os_reason().empty()
                                              ? "the file was left incomplete"
                                              : dir->hdf5_log()->last_os_reason()));
+  const nlohmann::json& js = re.summary;
   fmt::print("{}", sheardiff::analysis_result_text(js, run_dir));
+  if (!re.differs.empty())
+    fmt::print(
+        "the analysis differs from the run's own in {}: written to {} (summary.json, "
+        "analysis.h5); the run's files are as they were\n",
+        fmt::join(re.differs, ", "), re.folder.string());
   sheardiff::print_warnings(js);
   return 0;
 }
@@ -252,6 +303,34 @@ int check_sweep_command(const CommandLine& cl) {
              points.size(), spec.base.string());
   for (const auto& p : points) fmt::print("  {}\n", p.name);
   return 0;
+}
+
+// A run goes into a new folder, an empty one or a run's: a folder holding other files and no
+// run file (a home directory, a project folder) is refused before anything is written there.
+void refuse_foreign_folder(const std::filesystem::path& out) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(out, ec)) return;
+  std::vector<std::string> run_names;
+  for (const auto& n : sheardiff::run_file_names()) {
+    run_names.push_back(n);
+    run_names.push_back(n + ".tmp");
+  }
+  std::vector<std::string> others;
+  bool run_file = false;
+  for (const auto& e : std::filesystem::directory_iterator(out, ec)) {
+    const std::string name = e.path().filename().string();
+    if (std::find(run_names.begin(), run_names.end(), name) != run_names.end())
+      run_file = true;
+    else
+      others.push_back(name);
+  }
+  if (run_file || others.empty()) return;
+  std::sort(others.begin(), others.end());
+  if (others.size() > 3) others.resize(3), others.push_back("...");
+  throw sheardiff::ConfigError(fmt::format(
+      "--out {}: the folder holds other files ({}) and no run; a run goes into a new or empty "
+      "folder (nothing was written)",
+      out.string(), fmt::join(others, ", ")));
 }
 
 // `sheardiff check CONFIG` and `sheardiff run CONFIG`.
@@ -277,6 +356,7 @@ int config_command(CommandLine& cl, std::optional<sheardiff::RunDirectory>& dir)
         "{} is the config.toml of the run in {}, which --overwrite deletes: copy it elsewhere "
         "and run that copy",
         cl.config_path, cl.out_dir));
+  if (mode != RunMode::resume) refuse_foreign_folder(cl.out_dir);
   dir.emplace(cl.out_dir, mode != RunMode::resume);
   const auto summary = sheardiff::run_to_directory(cfg, *dir, mode, !cl.quiet, cl.progress_seconds);
   fmt::print("{}", sheardiff::run_result_first_line(summary, cl.out_dir));

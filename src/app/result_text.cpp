@@ -77,11 +77,18 @@ std::string run_result_details(const nlohmann::json& summary) {
           fmt::format("  steady state NOT reached (H or mu still drift); phi(now) = {:.4f}\n",
                       num(summary, "phi"));
     } else {
+      // An error bar that could not be formed is said so, never printed as "+- nan".
+      const auto pm = [&](const char* key) {
+        const double e = num(summary, key);
+        return std::isfinite(e) ? fmt::format(" +- {:.2g}", e) : std::string(" (no error bar)");
+      };
       details += fmt::format(
-          "  steady from strain {:.3g}: phi = {:.4f} +- {:.2g}, mu = {:.4f} +- {:.2g}, H = "
-          "{:.3f} d (+- statistical errors, time blocks)\n",
-          num(summary, "steady_strain"), num(summary, "phi"), num(summary, "phi_err"),
-          num(summary, "mu"), num(summary, "mu_err"), num(summary, "H"));
+          "  steady from strain {:.3g}: phi = {:.4f}{}, mu = {:.4f}{}, H = {:.3f} d ({})\n",
+          num(summary, "steady_strain"), num(summary, "phi"), pm("phi_err"), num(summary, "mu"),
+          pm("mu_err"), num(summary, "H"),
+          summary.contains("steady_errors_note")
+              ? summary["steady_errors_note"].get<std::string>()
+              : std::string("+- statistical errors, time blocks"));
       details += fmt::format(
           "  wall pressure check: measured {:.12f} P (max relative error {:.2e} over {} "
           "held steps)\n",

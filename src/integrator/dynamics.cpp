@@ -153,7 +153,7 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 
-void Dynamics::serialize(Archive& a) {
+void Dynamics::serialize(Archive& a, bool fluid_pattern) {
   a.tag("dynamics");
   a.io(particles_.position);
   a.io(particles_.unwrapped);
@@ -173,7 +173,8 @@ void Dynamics::serialize(Archive& a) {
   a.io(wall_state);
   if (a.loading() && walls_) walls_->driven_vx = wall_state[0];
   neighbours_.serialize(a);
-  if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs());
+  if (fluid_pattern) force_balance_.serialize_fluid_pattern(a);
+  if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs(), fluid_pattern);
 }
 
 Dynamics::Saved Dynamics::save() const {

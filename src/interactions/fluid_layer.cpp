@@ -27,15 +27,16 @@ int FluidLayer::element(double y, double& s) const {
   return e;
 }
 
-std::vector<std::pair<int, int>> FluidLayer::pattern(const Particles& p, int dof, int base) const {
+std::vector<std::pair<int, int>> FluidLayer::pattern(const std::vector<double>& heights, int dof,
+                                                     int base) const {
   std::vector<std::pair<int, int>> entries;
   for (int k = 1; k < cells_; ++k) {
     entries.emplace_back(unknown(k, base), unknown(k, base));
     if (k + 1 < cells_) entries.emplace_back(unknown(k + 1, base), unknown(k, base));
   }
-  for (std::size_t i = 0; i < p.n_mobile; ++i) {
+  for (std::size_t i = 0; i < heights.size(); ++i) {
     // Every node whose element the particle can reach before the next rebuild.
-    const double y = p.position[i].y();
+    const double y = heights[i];
     const int lo = static_cast<int>(std::floor((y - reach_ - y_lo_) / h_));
     const int hi = static_cast<int>(std::ceil((y + reach_ - y_lo_) / h_));
     for (int k = std::max(lo, 1); k <= std::min(hi, cells_ - 1); ++k) {

@@ -14,8 +14,9 @@ namespace sheardiff {
 
 namespace {
 
-// The digit is the state layout (CheckpointPayload::layout); 3 and 4 share the header.
-constexpr char kMagic[] = "sheardiff-checkpoint-4";
+// The digit is the state layout (CheckpointPayload::layout); 3, 4 and 5 share the header.
+constexpr char kMagic[] = "sheardiff-checkpoint-5";
+constexpr char kLayout4Magic[] = "sheardiff-checkpoint-4";
 constexpr char kLayout3Magic[] = "sheardiff-checkpoint-3";
 constexpr char kLegacyMagic[] = "sheardiff-checkpoint-2";
 constexpr std::uint64_t kMagicLength = sizeof(kMagic) - 1;
@@ -62,16 +63,25 @@ std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload) {
 }
 
 CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw_io_error("read", file);
-  std::vector<char> b(std::istreambuf_iterator<char>(in), {});
-  if (in.bad()) throw_io_error("read", file);
   const auto corrupt = [&](const std::string& why) {
     return CorruptCheckpoint(fmt::format(
         "{} is corrupt: {}. It was neither resumed nor changed; keep a copy if you need it, "
         "then start the run again with --overwrite",
         file.string(), why));
   };
+  // A stream opens a directory and fails only on reading it, with a message naming no file.
+  std::error_code ec;
+  if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
+    throw corrupt("it is not a regular file (a directory?)");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw_io_error("read", file);
+  std::vector<char> b;
+  try {
+    b.assign(std::istreambuf_iterator<char>(in), {});
+  } catch (const std::exception&) {
+    throw_io_error("read", file);
+  }
+  if (in.bad()) throw_io_error("read", file);
   CheckpointPayload out;
   if (starts_with_magic(b, kLegacyMagic)) {
     out.checksummed = false;
@@ -81,6 +91,8 @@ CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
   }
   if (starts_with_magic(b, kLayout3Magic))
     out.layout = 3;
+  else if (starts_with_magic(b, kLayout4Magic))
+    out.layout = 4;
   else if (!starts_with_magic(b, kMagic))
     throw corrupt(
         fmt::format("it does not begin with the magic \"{}\" ({} bytes)", kMagic, b.size()));

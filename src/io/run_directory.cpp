@@ -93,8 +93,8 @@ std::string this_command_line() {
 
 const std::vector<std::string>& run_file_names() {
   static const std::vector<std::string> names = {
-      "config.toml",  "trajectory.h5",  "analysis.h5",    "channel.h5",
-      "summary.json", "checkpoint.bin", "diagnostic.txt", kLog};
+      "config.toml",    "trajectory.h5",  "analysis.h5", "channel.h5", "summary.json",
+      "checkpoint.bin", "diagnostic.txt", kLog,          "reanalysis"};
   return names;
 }
 
@@ -269,7 +269,22 @@ RunDirectory::~RunDirectory() {
   if (fd_ >= 0) ::close(fd_);  // releases the lock
 }
 
+bool RunDirectory::moved() const {
+  struct stat held {
+  }, named{};
+  if (fd_ < 0 || fstat(fd_, &held) != 0) return false;
+  return stat(dir_.c_str(), &named) != 0 || named.st_dev != held.st_dev ||
+         named.st_ino != held.st_ino;
+}
+
 RunState RunDirectory::state() const {
+  if (moved()) {
+    // Asked of the locked directory itself, wherever it is now.
+    const auto has = [&](const char* name) { return faccessat(fd_, name, F_OK, 0) == 0; };
+    if (has("summary.json")) return RunState::finished;
+    if (has("checkpoint.bin")) return RunState::interrupted;
+    return RunState::started;
+  }
   std::error_code ec;
   if (fs::exists(file("summary.json"), ec)) return RunState::finished;
   if (fs::exists(file("checkpoint.bin"), ec)) return RunState::interrupted;
@@ -290,7 +305,7 @@ void RunDirectory::remove_run_files(bool keep_log) {
     for (const auto& f : {name, name + ".tmp"}) {
       if (keep_log && f == kLog) continue;
       std::error_code ec;
-      fs::remove(file(f), ec);
+      fs::remove_all(file(f), ec);  // reanalysis/ is a folder (analyse's output)
       if (ec) throw IoError(fmt::format("cannot remove {}: {}", file(f).string(), ec.message()));
     }
   }
@@ -300,6 +315,7 @@ void RunDirectory::remove_partial_files() {
   for (const auto& name : run_file_names()) {
     std::error_code ec;
     fs::remove(file(name + ".tmp"), ec);
+    fs::remove(file("reanalysis") / (name + ".tmp"), ec);
   }
 }
 

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "sheardiff/io/atomic_file.hpp"
@@ -75,23 +77,51 @@ void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter
   }
 }
 
-nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
+namespace {
+
+// The keys of `computed` merged into the run's summary: keys the run lacked are added, keys it
+// has must come out equal (else they are listed in `differs`); warnings are joined.
+nlohmann::json merge_analysis(const nlohmann::json& run, const nlohmann::json& computed,
+                              std::vector<std::string>& differs) {
+  nlohmann::json out = run;
+  for (const auto& [key, value] : computed.items()) {
+    if (key == "analysis_warnings") {
+      nlohmann::json w = run.value("analysis_warnings", nlohmann::json::array());
+      for (const auto& line : value)
+        if (std::find(w.begin(), w.end(), line) == w.end()) w.push_back(line);
+      out[key] = w;
+      continue;
+    }
+    if (run.contains(key) && run[key] != value) differs.push_back(key);
+    out[key] = value;
+  }
+  return out;
+}
+
+}  // namespace
+
+Reanalysis reanalyse_run(const std::filesystem::path& dir) {
   const auto traj = dir / "trajectory.h5";
   const Config cfg = load_config(dir / "config.toml");
-  nlohmann::json js;
+  nlohmann::json run;
   {
     std::ifstream in(dir / "summary.json");
     if (!in)
       throw std::runtime_error(
           fmt::format("{}: no summary.json (run not finished?)", dir.string()));
-    js = nlohmann::json::parse(in);
+    run = nlohmann::json::parse(in);
   }
+  if (scene_kind(cfg.scene.type).channel_flow)
+    throw ConfigError(fmt::format(
+        "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
+        "and summary.json, read by tools/channel_table.py",
+        dir.string()));
   // The measured window: frames from the detection of steady state (pressure cell) or after
-  // the transient (simple shear), the same test the observer applied while running.
+  // the transient (simple shear), the same test the observers applied while running.
   const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state;
-  if (pressure && !js.value("steady", false))
+  if (pressure && !run.value("steady", false))
     throw std::runtime_error(fmt::format("{}: the run never reached steady state", dir.string()));
-  const double from = pressure ? js["steady_detected_at"].get<double>() : cfg.run.transient_strain;
+  const double from = pressure ? run["steady_detected_at"].get<double>() : cfg.run.transient_strain;
   const ObservableSeries strain = read_h5md_observable(traj, "strain");
   std::vector<long> frames;
   for (std::size_t k = 0; k < strain.value.size(); ++k)
@@ -100,6 +130,9 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
   if (frames.size() < 4)
     throw std::runtime_error(
         fmt::format("{}: only {} frames in the measured window", dir.string(), frames.size()));
+  // The run measured its profiles at every step; frames can only approximate them, so they are
+  // computed here only for a run that has none (an older version's).
+  const bool want_profiles = pressure && !run.contains("profile_phi");
   Eigen::MatrixXd y, vy;
   Eigen::VectorXd bottom(static_cast<Eigen::Index>(frames.size())), top(bottom.size());
   bool walls = false;
@@ -135,8 +168,10 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
     }
     if (nb > 0 && nt > 0) {
       walls = true;
-      bottom(static_cast<Eigen::Index>(row)) = yb / static_cast<double>(nb);
-      top(static_cast<Eigen::Index>(row)) = yt / static_cast<double>(nt);
+      const auto r = static_cast<Eigen::Index>(row);
+      bottom(r) = yb / static_cast<double>(nb);
+      top(r) = yt / static_cast<double>(nt);
+      if (!want_profiles) continue;
       Particles p;
       p.n_mobile = mobile.size();
       std::vector<Vec3> u;
@@ -145,37 +180,56 @@ nlohmann::json reanalyse_run(const std::filesystem::path& dir) {
         p.radius.push_back(0.5 * f.diameter[mobile[c]]);
         u.push_back(f.velocity[mobile[c]]);
       }
-      const double h = top(static_cast<Eigen::Index>(row)) - bottom(static_cast<Eigen::Index>(row));
+      const double h = top(r) - bottom(r);
       height_sum += h;
-      profiles.add(p, u, bottom(static_cast<Eigen::Index>(row)), h, f.lx, 1.0);
+      profiles.add(p, u, bottom(r), h, f.lx, 1.0);
     }
   }
   Eigen::MatrixXd mask;
   if (walls) mask = bulk_mask(y, bottom, top, cfg.observables.wall_exclusion);
-  const DiffusionReport r = analyse_diffusion(y, vy, cfg.output.frame_strain,
-                                              diffusion_settings(cfg), walls ? &mask : nullptr);
-  add_to_summary(r, js);
+  nlohmann::json computed;
+  std::optional<DiffusionReport> r;
+  try {
+    r = analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg),
+                          walls ? &mask : nullptr);
+    add_to_summary(*r, computed);
+  } catch (const std::invalid_argument& e) {
+    // As in the run: too little data for the fits is a finding, the rest is still computed.
+    computed["analysis_warnings"] = {fmt::format("no diffusion analysis: {}", e.what())};
+  }
   if (pressure) {
-    // The steady window's error bars and profiles from the frames (a run measures its profiles
-    // every step; these are frame averages over the same window).
+    // The steady window's error bars and stationarity from the frames: the samples the run's
+    // observer took (every frame from the detection of steady state on).
     const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
     const auto h = series("H"), mu_top = series("mu_top"), mu_bottom = series("mu_bottom");
-    add_steady_errors(js, strain.value, h, series("phi"), mu_top, mu_bottom, from,
-                      strain.value.back(), cfg.analysis.error_block);
+    const double last = strain.value[static_cast<std::size_t>(frames.back())];
+    add_steady_errors(computed, strain.value, h, series("phi"), mu_top, mu_bottom, from, last,
+                      cfg.analysis.error_block);
     if (has_h5md_observable(traj, "net_drag_y"))
-      add_stationarity(
-          js, pressure_cell_stationarity(cfg.steady, strain.value, h, mu_top, mu_bottom,
-                                         series("net_drag_y"), series("bulk_normal_load"), from,
-                                         strain.value.back(), cfg.analysis.error_block));
-    if (walls)
-      profiles.to_summary(js, cfg.flow.j, height_sum / static_cast<double>(frames.size()),
+      add_stationarity(computed,
+                       pressure_cell_stationarity(cfg.steady, strain.value, h, mu_top, mu_bottom,
+                                                  series("net_drag_y"), series("bulk_normal_load"),
+                                                  from, last, cfg.analysis.error_block));
+    if (want_profiles && walls) {
+      profiles.to_summary(computed, cfg.flow.j, height_sum / static_cast<double>(frames.size()),
                           cfg.observables.wall_exclusion);
+      computed["profiles_from"] = "frames";
+    }
   }
-  write_analysis_file(r, dir / "analysis.h5");
+  Reanalysis out;
+  out.summary = merge_analysis(run, computed, out.differs);
+  // Nothing the run wrote is replaced: where the analysis disagrees with it (an older version's
+  // numbers), the whole analysis goes beside the run's files.
+  out.folder = out.differs.empty() ? dir : dir / "reanalysis";
+  const bool summary_changes = out.summary != run;
   // The run's own version stays; the analysis says which code recomputed it.
-  js["analysed_by"] = version_line();
-  write_file_atomically(dir / "summary.json", json_text(js) + "\n");
-  return js;
+  if (summary_changes) out.summary["analysed_by"] = version_line();
+  if (!out.differs.empty()) std::filesystem::create_directories(out.folder);
+  if (r && (!out.differs.empty() || !std::filesystem::exists(dir / "analysis.h5")))
+    write_analysis_file(*r, out.folder / "analysis.h5");
+  if (summary_changes)
+    write_file_atomically(out.folder / "summary.json", json_text(out.summary) + "\n");
+  return out;
 }
 
 }  // namespace sheardiff

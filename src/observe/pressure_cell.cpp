@@ -12,11 +12,31 @@
 
 namespace sheardiff {
 
+namespace {
+
+// Frames in [from, to]: the run passes the window's frames only, analyse the whole trajectory.
+long frames_between(const std::vector<double>& strain, double from, double to) {
+  return std::count_if(strain.begin(), strain.end(),
+                       [&](double s) { return s >= from && s <= to; });
+}
+
+constexpr long kMinWindowFrames = 8;
+
+}  // namespace
+
 void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
                        const std::vector<double>& h, const std::vector<double>& phi,
                        const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
                        double from, double to, double block) {
-  if (!(to > from) || strain.size() < 8) return;
+  const long n = to > from ? frames_between(strain, from, to) : 0;
+  if (n < kMinWindowFrames) {
+    // Said rather than printed as "+- nan": too few frames to form blocks from.
+    js["steady_errors_note"] = fmt::format(
+        "no error bars: {} frames in the measured window, {} needed (lower output.frame_strain "
+        "or measure longer)",
+        n, kMinWindowFrames);
+    return;
+  }
   const long blocks = std::max(4L, static_cast<long>((to - from) / block));
   std::vector<double> mu(mu_top.size());
   for (std::size_t k = 0; k < mu.size(); ++k) mu[k] = 0.5 * (mu_top[k] + mu_bottom[k]);
@@ -37,7 +57,7 @@ StationarityVerdict pressure_cell_stationarity(
     const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
     double to, double block) {
   StationarityVerdict v;
-  if (!(to > from) || strain.size() < 8) return v;
+  if (!(to > from) || frames_between(strain, from, to) < kMinWindowFrames) return v;
   const long blocks = std::max(4L, static_cast<long>((to - from) / block));
   std::vector<double> dmu(mu_top.size());
   for (std::size_t k = 0; k < dmu.size(); ++k) dmu[k] = mu_top[k] - mu_bottom[k];
@@ -126,7 +146,9 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
   const double load = normal_load_between(d, v.velocities, y1, y2, lz_) / pressure_;
   values.insert(values.end(), {h, phi, mu_top, mu_bottom, v.stress.top_wall_fy / a,
                                v.velocities.wall_v, drag, load});
-  if (steady()) {
+  // The measured window's frames: from the one at which steady state is detected on, the
+  // frames the diffusion analysis and `sheardiff analyse` use.
+  const auto sample = [&] {
     s_strain_.push_back(d.strain());
     s_h_.push_back(h);
     s_phi_.push_back(phi);
@@ -134,8 +156,8 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
     s_mu_bottom_.push_back(mu_bottom);
     s_drag_.push_back(drag);
     s_load_.push_back(load);
-    return;
-  }
+  };
+  if (steady()) return sample();
   hist_strain_.push_back(d.strain());
   hist_h_.push_back(h);
   hist_mu_.push_back(mu_top);
@@ -158,6 +180,7 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
       std::abs(m2 - m1) <= steady_cfg_.mu_tolerance) {
     steady_at_ = now;
     steady_from_ = start;
+    sample();
   }
 }
 
@@ -216,11 +239,13 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
   js["mu_bottom"] = mu_bottom_ / w_;
   js["pressure_measured"] = p_meas_ / w_;
   js["measured_strain"] = d.strain() - steady_at_;
-  add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, d.strain(),
+  // The window's blocks span its frames, first to last: what `sheardiff analyse` sees too.
+  const double last = s_strain_.empty() ? d.strain() : s_strain_.back();
+  add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, last,
                     error_block_);
   add_stationarity(
       js, pressure_cell_stationarity(steady_cfg_, s_strain_, s_h_, s_mu_top_, s_mu_bottom_, s_drag_,
-                                     s_load_, steady_at_, d.strain(), error_block_));
+                                     s_load_, steady_at_, last, error_block_));
   (void)writer;
 }
 

@@ -3,11 +3,41 @@
 #include <cmath>
 
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/scene/registry.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
 namespace sheardiff {
 
 namespace {
+
+// A run's own frames overlap by ~1/ktilde of a diameter; discs much closer than contact (two
+// at one spot, a file in other units) would start the contact law from forces it cannot
+// resolve. Checked over all pairs: init files are read once, at most some 10^4 discs.
+constexpr double kMaxStartOverlap = 0.2;  // of the pair's contact distance
+
+void refuse_overlaps(const Packing& pk, bool periodic_y, const std::filesystem::path& file) {
+  const std::size_t n = pk.position.size();
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      double dx = pk.position[j].x() - pk.position[i].x();
+      double dy = pk.position[j].y() - pk.position[i].y();
+      if (periodic_y && pk.ly > 0.0) {
+        const double k = std::round(dy / pk.ly);
+        dy -= k * pk.ly;
+        dx -= k * pk.tilt;
+      }
+      if (pk.lx > 0.0) dx -= pk.lx * std::round(dx / pk.lx);
+      const double contact = pk.radius[i] + pk.radius[j];
+      const double r = std::hypot(dx, dy);
+      if (r < (1.0 - kMaxStartOverlap) * contact)
+        throw ConfigError(fmt::format(
+            "particles.init_file: {}: mobile particles {} and {} (counted from 0) are {:.4g} d "
+            "apart, overlapping by {:.0f} % of their contact distance {:.4g} d (at most {:.0f} % "
+            "allowed): not a packing to start from; check the file's positions and units",
+            file.string(), i, j, r, 100.0 * (1.0 - r / contact), contact,
+            100.0 * kMaxStartOverlap));
+    }
+}
 
 Packing packing_from_file(const Config& cfg) {
   const std::filesystem::path file = cfg.particles.init_file;
@@ -44,6 +74,7 @@ Packing packing_from_file(const Config& cfg) {
         fmt::format("particles.init_file: {} holds {} mobile particles but "
                     "particles.N = {}",
                     file.string(), pk.position.size(), cfg.particles.n));
+  refuse_overlaps(pk, scene_kind(cfg.scene.type).periodic_y, file);
   return pk;
 }
 

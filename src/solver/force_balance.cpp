@@ -16,12 +16,16 @@ ForceBalance::ForceBalance(PairLaws laws, int dof, bool implicit_springs,
       system_(dof, cholesky),
       diagonal_only_(!laws_.resistive() && !implicit_springs) {}
 
-void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs) {
+void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs, bool restored) {
   terms_.assign(pairs.size(), PairTerm{});
   if (fluid_) {
+    if (!restored || pattern_y_.size() != p.n_mobile) {
+      pattern_y_.resize(p.n_mobile);
+      for (std::size_t i = 0; i < p.n_mobile; ++i) pattern_y_[i] = p.position[i].y();
+    }
     const int base = system_.dof() * static_cast<int>(p.n_mobile);
     system_.set_pattern(p.n_mobile, pairs, p, false, fluid_->unknowns(),
-                        fluid_->pattern(p, system_.dof(), base));
+                        fluid_->pattern(pattern_y_, system_.dof(), base));
     fluid_load_ = fluid_->load(system_.unknowns(), base);
   } else {
     system_.set_pattern(p.n_mobile, pairs, p, diagonal_only_);

@@ -55,6 +55,43 @@ std::string csv_text(const std::vector<std::string>& columns,
   return csv.str();
 }
 
+// The rows of a sweep.csv written by csv_text, each cell as its text, by column name.
+std::vector<std::map<std::string, std::string>> read_csv_rows(const fs::path& file) {
+  std::ifstream in(file);
+  std::string text(std::istreambuf_iterator<char>(in), {});
+  std::vector<std::vector<std::string>> lines(1);
+  std::string cell;
+  bool quoted = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (quoted) {
+      if (c == '"' && k + 1 < text.size() && text[k + 1] == '"')
+        cell += '"', ++k;
+      else if (c == '"')
+        quoted = false;
+      else
+        cell += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      lines.back().push_back(std::move(cell)), cell.clear();
+    } else if (c == '\n') {
+      lines.back().push_back(std::move(cell)), cell.clear();
+      lines.emplace_back();
+    } else {
+      cell += c;
+    }
+  }
+  std::vector<std::map<std::string, std::string>> rows;
+  for (std::size_t r = 1; r < lines.size(); ++r) {
+    if (lines[r].size() != lines[0].size()) continue;
+    std::map<std::string, std::string> row;
+    for (std::size_t c = 0; c < lines[0].size(); ++c) row[lines[0][c]] = lines[r][c];
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
 // A summary flattened to scalars: arrays become key_0, key_1, ...
 void flatten(const json& summary, std::map<std::string, json>& row) {
   for (const auto& [k, v] : summary.items()) {
@@ -377,10 +414,67 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
     table.push_back(std::move(row));
   }
 
+  // Finished points in DIR that this sweep file does not list (a sweep over a part of them,
+  // or the file edited since) stay in DIR's tables: their axis values come from the row the
+  // earlier collection wrote, their numbers from their own summary. One whose row lacks an
+  // axis of this sweep is listed but left out of the fits.
+  std::set<std::string> ours, kept_axes;
+  for (const auto& p : points) ours.insert(p.name);
+  std::map<std::string, std::map<std::string, std::string>> earlier;
+  if (fs::exists(out_dir / "sweep.csv"))
+    for (auto& r : read_csv_rows(out_dir / "sweep.csv")) earlier[r["point"]] = r;
+  long kept = 0;
+  std::error_code ec;
+  if (fs::is_directory(out_dir / "points", ec))
+    for (const auto& e : fs::directory_iterator(out_dir / "points")) {
+      const std::string name = e.path().filename().string();
+      if (ours.count(name) || !fs::exists(e.path() / "summary.json")) continue;
+      std::ifstream in(e.path() / "summary.json");
+      const json summary = json::parse(in, nullptr, false);
+      if (summary.is_discarded()) continue;
+      std::map<std::string, json> row;
+      row["point"] = name;
+      const auto& before = earlier[name];
+      for (const auto& [col, text] : before)
+        if (col.starts_with("axis.") || col.starts_with("paired."))
+          row[col] = text, kept_axes.insert(col);
+      std::map<std::string, json> flat;
+      flatten(summary, flat);
+      for (auto& [k, v] : flat) summary_keys.insert(k), row[k] = v;
+      const std::string verdict = window_verdict(summary);
+      row["status"] = verdict.empty() ? std::string("done") : verdict;
+      ++kept, ++finished;
+      std::string group_key;
+      json axes = json::object();
+      bool placed = true;
+      for (const auto& [key, values] : spec.axes) {
+        if (key == "flow.J" || is_seed_axis(key)) continue;
+        const auto it = before.find("axis." + key);
+        if (it == before.end() || it->second.empty()) {
+          placed = false;
+          break;
+        }
+        group_key += key + "=" + it->second + " ";
+        axes[key] = json::parse(it->second, nullptr, false);
+      }
+      if (placed && verdict.empty() && summary.contains("J")) {
+        groups[group_key][summary["J"].get<double>()].push_back(summary);
+        group_axes[group_key] = axes;
+      }
+      table.push_back(std::move(row));
+    }
+  if (kept > 0)
+    fmt::print(stderr,
+               "sweep: {} finished points in {} lie outside this sweep file's axes: they stay in "
+               "its sweep.csv and fits.json\n",
+               kept, (out_dir / "points").string());
+
   // sweep.csv: fixed leading columns, then the axes, then every summary key.
   std::vector<std::string> columns = {"point", "status"};
   for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
   for (const auto& pk : spec.paired) columns.push_back("paired." + pk.key);
+  for (const auto& col : kept_axes)
+    if (std::find(columns.begin(), columns.end(), col) == columns.end()) columns.push_back(col);
   columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
   fs::create_directories(out_dir);
   write_file_atomically(out_dir / "sweep.csv", csv_text(columns, table));
@@ -389,8 +483,6 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   // to a sweep that covers the whole store, instead of replacing them with fits over its part.
   bool whole_store = true;
   if (!spec.results.empty() && fs::is_directory(spec.results / "points")) {
-    std::set<std::string> ours;
-    for (const auto& p : points) ours.insert(p.name);
     for (const auto& e : fs::directory_iterator(spec.results / "points"))
       if (fs::exists(e.path() / "summary.json") && !ours.count(e.path().filename().string()))
         whole_store = false;
@@ -408,12 +500,19 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
 
   json fits;
   fits["sweep"] = spec.file.filename().string();
-  fits["points"] = points.size();
+  fits["points"] = points.size() + static_cast<std::size_t>(kept);
   fits["finished"] = finished;
   // The seed's Table 1 sits beside fits of J-sweeps only: a sweep of another scene (channel
   // cases over seeds) has no J axis to fit and is not that paper's measurement.
   if (!groups.empty()) fits["seed_table1"] = seed_reference();
   fits["groups"] = json::array();
+  // Each J's seeds in seed order, however their points were found (listed by this sweep file or
+  // kept from an earlier one): the seed bootstrap draws by position.
+  for (auto& [key, by_j] : groups)
+    for (auto& [j, runs] : by_j)
+      std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
+        return a.value("seed", 0L) < b.value("seed", 0L);
+      });
   for (const auto& [key, by_j] : groups)
     fits["groups"].push_back(fits_of_group(by_j, group_axes[key]));
   write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <map>
 
 #include "sheardiff/config.hpp"
@@ -51,11 +52,29 @@ class FileLock {
   int fd_ = -1;
 };
 
+// Whether another process holds the lock of FILE now (a worker of an earlier sweep whose pool
+// was killed keeps its point's lock until it ends).
+bool locked_elsewhere(const fs::path& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool held = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+  ::close(fd);  // releases it if this probe took it
+  return held;
+}
+
+fs::path point_lock(const fs::path& out_dir, const SweepPoint& p) {
+  return out_dir / "logs" / (p.name + ".lock");
+}
+
 }  // namespace
 
-void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
+void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir,
+               const std::function<void(const RunDirectory&, const nlohmann::json&)>& report) {
   fs::create_directories(out_dir / "logs");
-  const FileLock lock(out_dir / "logs" / (p.name + ".lock"), "sweep point " + p.name);
+  if (locked_elsewhere(point_lock(out_dir, p)))
+    throw PointBusy(fmt::format("sweep point {} is being run by another process (lock {})", p.name,
+                                point_lock(out_dir, p).string()));
+  const FileLock lock(point_lock(out_dir, p), "sweep point " + p.name);
   const auto state = point_state(spec, p, out_dir);
   if (state == PointState::finished) return;
   const Config cfg = load_config(spec.base, p.overrides);
@@ -67,8 +86,11 @@ void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_d
   if (state == PointState::fresh)
     if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
       throw ConfigError("sweep point " + p.name + ": " + lost);
-  run_to_directory(cfg, dir, state == PointState::resumable ? RunMode::resume : RunMode::overwrite,
-                   true);
+  const nlohmann::json summary = run_to_directory(
+      cfg, dir, state == PointState::resumable ? RunMode::resume : RunMode::overwrite, true);
+  // While the run directory's log is open: the result goes to its run.log and to the point's
+  // log of the pool (the worker's output).
+  if (report) report(dir, summary);
   export_point(spec, p, out_dir);
 }
 
@@ -117,14 +139,27 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
     fmt::print(stderr, "{}\n", w);
 
   // States first (a foreign directory stops the sweep before anything starts), longest first.
-  std::vector<const SweepPoint*> todo;
+  std::vector<const SweepPoint*> todo, elsewhere;
   long finished_before = 0;
+  std::error_code ec;
   for (const auto& p : points) {
-    if (point_state(spec, p, out_dir) == PointState::finished)
+    if (point_state(spec, p, out_dir) == PointState::finished) {
       ++finished_before;
-    else
+      // A failure recorded by an earlier attempt no longer describes the point.
+      fs::remove(out_dir / "logs" / (p.name + ".failed"), ec);
+    } else if (locked_elsewhere(point_lock(out_dir, p))) {
+      elsewhere.push_back(&p);
+    } else {
       todo.push_back(&p);
+    }
   }
+  // Workers of an earlier pool that was killed (SIGKILL, a lost terminal) still run their
+  // points: they are waited for, not started twice nor counted as failed.
+  if (!elsewhere.empty())
+    fmt::print(stderr,
+               "sweep: {} point(s) are being run by other processes (the workers of an earlier "
+               "sweep whose pool was stopped?): waiting for them, not starting them again\n",
+               elsewhere.size());
   std::stable_sort(todo.begin(), todo.end(),
                    [](const SweepPoint* a, const SweepPoint* b) { return a->cost > b->cost; });
   std::reverse(todo.begin(), todo.end());  // taken from the back
@@ -191,6 +226,9 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
         ++done;
         done_cost += p.cost;
         done_seconds += secs;
+      } else if (!stop_signal && locked_elsewhere(point_lock(out_dir, p))) {
+        // Taken by another process between the check and the start: waited for like the others.
+        elsewhere.push_back(&p);
       } else if (!stop_signal) {
         ++failed;
         fmt::print(stderr, "{}sweep: point {} failed (exit {}) after {}; see {}\n", stamp(), p.name,
@@ -223,13 +261,34 @@ int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs
                "{}sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
                "{} elapsed, ETA {}\n",
                stamp(), finished_before + done, points.size(), finished_before, failed,
-               running.size(), todo.size(), duration_text(elapsed), eta);
+               running.size() + elsewhere.size(), todo.size(), duration_text(elapsed), eta);
     last_print = now;
     changed = false;
   };
 
-  while (!todo.empty() || !running.empty()) {
-    while (!stop_signal && static_cast<int>(running.size()) < jobs && !todo.empty()) {
+  // A point run elsewhere is checked at each tick: once its lock is free it is finished (done)
+  // or goes back to the queue (it resumes from its checkpoint).
+  const auto poll_elsewhere = [&] {
+    for (auto it = elsewhere.begin(); it != elsewhere.end();) {
+      if (locked_elsewhere(point_lock(out_dir, **it))) {
+        ++it;
+        continue;
+      }
+      if (point_state(spec, **it, out_dir) == PointState::finished) {
+        ++finished_before;
+        fs::remove(out_dir / "logs" / ((*it)->name + ".failed"), ec);
+      } else {
+        todo.insert(todo.begin(), *it);
+      }
+      it = elsewhere.erase(it);
+      changed = true;
+    }
+  };
+
+  while (!todo.empty() || !running.empty() || (!elsewhere.empty() && !stop_signal)) {
+    poll_elsewhere();
+    while (!stop_signal && static_cast<int>(running.size() + elsewhere.size()) < jobs &&
+           !todo.empty()) {
       spawn(todo.back());
       todo.pop_back();
       changed = true;

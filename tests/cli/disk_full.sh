@@ -79,5 +79,21 @@ while ((hi - lo > 4)); do
   if try_size $mid; then hi=$mid; else lo=$mid last=$what; fi
 done
 report+=" ${lo}k:$last (the largest that fails; ${hi}k fits)"
+# `analyse` meeting the full disk as it writes analysis.h5 (issue 35, case 8, left a 0-byte
+# analysis.h5.tmp): exit 1 naming the file and the reason, no FILE.tmp, summary.json as it was.
+umount -q mnt && mount -t tmpfs -o size=4m tmpfs mnt || fail "mount for analyse"
+cp -r ref mnt/a && rm mnt/a/analysis.h5 || fail "copy for analyse"
+# Fill the mount, then free two pages: the log's lines fit, the 14 kB analysis.h5 does not.
+dd if=/dev/zero of=mnt/fill bs=4k > /dev/null 2>&1
+truncate -s -8k mnt/fill || fail "truncate"
+rc=0
+"$bin" analyse mnt/a > out.txt 2> err.txt || rc=$?
+[ "$rc" = 1 ] || fail "analyse on a full disk: exit $rc, expected 1: $(head -3 err.txt)"
+grep -q "^error: .*mnt/a/analysis.h5.*: No space left on device" err.txt ||
+  fail "analyse on a full disk: the message lacks the file or the reason: $(cat err.txt)"
+compgen -G "mnt/a/*.tmp" > /dev/null && fail "analyse on a full disk left partial files: $(ls mnt/a)"
+cmp -s mnt/a/summary.json ref/summary.json || fail "analyse on a full disk changed summary.json"
+report+="; analyse on a full disk: exit 1, no partial file"
+
 echo "disk_full: a run of $full_kb kB on tmpfs mounts of size:file that met the full disk, each" \
   "then resumed to the reference:$report"

@@ -44,6 +44,18 @@ expect 2 "--resume excludes --overwrite" -- run run.toml --resume ok --overwrite
 expect 2 "--jobs: Value 0 not in range" -- sweep s.toml --out o --jobs 0
 expect 2 "--point: Value abc not in range" -- sweep s.toml --out o --point abc
 expect 2 "--backend: pbs not in {local,slurm}" -- sweep s.toml --out o --backend pbs
+# Issue 35, case 12: nan seconds turned progress off, "" exited 1, / wrote a run into the root.
+expect 2 "--progress-every: nan: must be a finite number > 0" -- run run.toml --out a --progress-every nan
+expect 2 "--progress-every: inf: must be a finite number > 0" -- run run.toml --out a --progress-every inf
+expect 2 "--out: an empty path" -- run run.toml --out ""
+expect 2 "--out: / is a filesystem root" -- run run.toml --out /
+expect 2 "--out: / is a filesystem root" -- sweep s.toml --out /
+expect 2 "--out: an empty path" -- fit ok --out ""
+# A folder of someone else's files is not a run directory.
+mkdir mine && echo "notes" > mine/notes.txt
+expect 2 "--out mine: the folder holds other files (notes.txt) and no run" -- run run.toml --out mine
+expect 2 "--out mine: the folder holds other files (notes.txt) and no run" -- run run.toml --out mine --overwrite
+[ "$(ls mine)" = notes.txt ] || { echo "FAIL: a refused run wrote into mine/: $(ls mine)"; failed=1; }
 [ -e a ] || [ -e o ] && { echo "FAIL: a refused command created its folder"; failed=1; }
 
 # 2: a damaged summary.json is an invalid input file, named.

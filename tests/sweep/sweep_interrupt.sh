@@ -64,4 +64,30 @@ for p in $finished; do rows "$p"; done | diff before.rows -   # same rows
 for p in $finished; do wc -c < "out/logs/$p.log"; done | diff before.logsize - # not rerun
 [ "$(grep -c '^[^,]*,"\?done' out/sweep.csv)" = 4 ] || { echo "not all points done"; cat second.log; exit 1; }
 grep -q "before this start" second.log
+# Every point's log holds its result as `run` prints it (issue 35, case 9: they were empty),
+# and so does its run.log.
+for d in out/points/*/; do
+  p=$(basename "$d")
+  grep -q "steps" "out/logs/$p.log" || { echo "out/logs/$p.log lacks the point's result"; exit 1; }
+  grep -q "steps" "$d/run.log" || { echo "$d/run.log lacks the point's result"; exit 1; }
+done
+
+# Issue 35, case 6: a point whose lock another process holds (the worker of a pool that was
+# killed alone lives on) was started again, failed (exit 3) and left a .failed marker behind.
+# It is waited for instead; a stale marker of a finished point is removed.
+mkdir -p out2/logs
+first_point=$("$bin" check tiny.toml | sed -n 2p | tr -d ' ')
+flock -n "out2/logs/$first_point.lock" -c "sleep 3" &
+holder=$!
+sleep 0.5
+rc=0; "$bin" sweep tiny.toml --out out2 > orphan.log 2>&1 || rc=$?
+wait "$holder" || true
+[ "$rc" = 0 ] || { echo "sweep beside a running worker: exit $rc"; cat orphan.log; exit 1; }
+grep -q "being run by other processes" orphan.log || { echo "no word of the other process"; cat orphan.log; exit 1; }
+[ "$(grep -c '^[^,]*,"\?done' out2/sweep.csv)" = 4 ] || { echo "not all points done"; cat orphan.log; exit 1; }
+compgen -G "out2/logs/*.failed" > /dev/null && { echo "failure markers left: $(ls out2/logs)"; exit 1; }
+echo "an earlier failure" > "out2/logs/$first_point.failed"
+"$bin" sweep tiny.toml --out out2 > again.log 2>&1
+[ -e "out2/logs/$first_point.failed" ] && { echo "a stale failure marker of a finished point stayed"; exit 1; }
+
 echo "sweep_interrupt: killed after $(echo "$finished" | wc -w) finished point(s); resumed to 4/4 with them untouched"

@@ -39,7 +39,9 @@ FluidSolve solve_pinned(const Particles& p, const FluidLayer& fl, const ImposedF
                         double pin) {
   ResistanceSystem sys(2, "cholmod");
   const int base = 2 * static_cast<int>(p.n_mobile);
-  sys.set_pattern(p.n_mobile, {}, p, false, fl.unknowns(), fl.pattern(p, 2, base));
+  std::vector<double> heights;
+  for (std::size_t i = 0; i < p.n_mobile; ++i) heights.push_back(p.position[i].y());
+  sys.set_pattern(p.n_mobile, {}, p, false, fl.unknowns(), fl.pattern(heights, 2, base));
   sys.clear();
   for (std::size_t i = 0; i < p.n_mobile; ++i) {
     const Vec3 zeta = StokesDrag::resistance(p.radius[i]);

@@ -251,6 +251,123 @@ TEST(Checkpoint, ResumeNeverRestartsARunThatGotPastItsFirstCheckpoint) {
   fs::remove_all(root);
 }
 
+// A resumed run whose config.toml had been deleted finished without it, and `analyse` then
+// failed: the resume writes it again from the checkpoint's (checked) configuration.
+TEST(Checkpoint, ResumeWritesADeletedConfigAgain) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_lost_config";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  const fs::path dir = root / "run";
+  make_interrupted_run(cfg, dir);
+  const std::string config = text_of(dir / "config.toml");
+  fs::remove(dir / "config.toml");
+  const fs::path err = root / "err.txt";
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, dir, {}, err)), 0) << text_of(err);
+  EXPECT_NE(text_of(err).find("config.toml was missing"), std::string::npos) << text_of(err);
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_EQ(text_of(dir / "config.toml"), config);
+  fs::remove_all(root);
+}
+
+// Issue 35, case 11: a checkpoint.bin that is a directory gave "basic_filebuf::underflow error
+// ... Is a directory" naming no file; a run whose directory was renamed under it said "No
+// checkpoint was written yet" though one existed.
+TEST(Checkpoint, MessagesNameTheFileAndWhereTheRunWent) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_messages";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  const fs::path err = root / "err.txt";
+  make_interrupted_run(cfg, root / "dir_checkpoint");
+  fs::remove(root / "dir_checkpoint" / "checkpoint.bin");
+  fs::create_directory(root / "dir_checkpoint" / "checkpoint.bin");
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "dir_checkpoint", {}, err)), 2);
+  EXPECT_NE(text_of(err).find((root / "dir_checkpoint" / "checkpoint.bin").string() +
+                              " is corrupt: it is not a regular file"),
+            std::string::npos)
+      << text_of(err);
+  EXPECT_TRUE(fs::is_directory(root / "dir_checkpoint" / "checkpoint.bin"));
+
+  // Renamed once its first checkpoint exists: the next checkpoint cannot be written there.
+  const fs::path dir = root / "run", moved = root / "moved";
+  const pid_t pid = spawn_run(cfg, {"--out", dir.string()}, err);
+  for (int k = 0; k < 4000 && !fs::exists(dir / "checkpoint.bin"); ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  fs::rename(dir, moved);
+  EXPECT_EQ(wait_exit(pid), 1);
+  const std::string m = text_of(err);
+  EXPECT_NE(m.find(dir.string() + " was moved or removed while the run ran"), std::string::npos)
+      << m;
+  EXPECT_NE(m.find("its checkpoint.bin went with it"), std::string::npos) << m;
+  EXPECT_EQ(m.find("No checkpoint was written yet"), std::string::npos) << m;
+  // And it continues where it is now.
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, moved, {}, err)), 0) << text_of(err);
+  EXPECT_TRUE(fs::exists(moved / "summary.json"));
+  fs::remove_all(root);
+}
+
+// Issue 35, case 3: channel runs resumed 1e-13 d off in the first frame after the checkpoint and
+// 2e-6 d later: the fluid layer's sparsity pattern was rebuilt from the positions at the
+// checkpoint instead of those at the last neighbour rebuild, so CHOLMOD ordered another matrix.
+// Layout 5 keeps those heights: a channel run killed and resumed ends bit-identical.
+TEST(Checkpoint, ChannelResumeIsBitIdentical) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_channel_resume";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const fs::path cfg = root / "channel.toml";
+  // Case D of configs/channel (86 discs, H = 40.4 a), whose resumes differed from strain 20 on.
+  std::ofstream(cfg) << R"([scene]
+type = "channel"
+[particles]
+size_ratio = 1.0
+[channel]
+phi = 0.4
+h_over_a = 40.4
+wall_discs = 7
+coupling = "two_way"
+sample_interval = 50.0
+steady_window = 6000.0
+[contact]
+mu = 0.0
+[repulsion]
+F0 = 9.42477796076938
+lambda = 0.0005
+[run]
+strain = 120.0
+seed = 1
+[analysis]
+diffusion = false
+[output]
+frame_strain = 10.0
+checkpoint_strain = 20.0
+)";
+  ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
+  // Killed once its first checkpoint (strain 20) exists: resumed from there.
+  const pid_t pid = spawn(cfg, root / "stopped");
+  for (int k = 0; k < 20000 && !fs::exists(root / "stopped" / "checkpoint.bin"); ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  kill(pid, SIGKILL);
+  if (wait_exit(pid) == 0) GTEST_SKIP() << "the run finished before the kill landed";
+  ASSERT_TRUE(fs::exists(root / "stopped" / "checkpoint.bin"));
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
+  const long n = count_h5md_frames(root / "whole" / "trajectory.h5");
+  ASSERT_EQ(count_h5md_frames(root / "stopped" / "trajectory.h5"), n);
+  for (long f = 0; f < n; ++f) {
+    const H5mdFrame a = read_h5md_frame(root / "whole" / "trajectory.h5", f);
+    const H5mdFrame b = read_h5md_frame(root / "stopped" / "trajectory.h5", f);
+    ASSERT_EQ(a.position.size(), b.position.size());
+    for (std::size_t i = 0; i < a.position.size(); ++i)
+      ASSERT_EQ(a.position[i], b.position[i]) << "frame " << f << ", particle " << i;
+  }
+  nlohmann::json sa, sb;
+  std::ifstream(root / "whole" / "summary.json") >> sa;
+  std::ifstream(root / "stopped" / "summary.json") >> sb;
+  for (const char* clock : {"wall_seconds", "ms_per_step", "started", "finished"})
+    sa.erase(clock), sb.erase(clock);
+  EXPECT_EQ(sa, sb);
+  fs::remove_all(root);
+}
+
 // Issue 16: a flipped mantissa byte resumed to exit 0 with other results, a flipped exponent
 // was reported as "top wall escaped" (exit 4) and the checkpoint overwritten, a corrupt length
 // ended in std::bad_alloc without the file's name. Each must be named as corrupt (exit 2) and
@@ -345,7 +462,7 @@ TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
-  const std::string now = "sheardiff-checkpoint-4", before = "sheardiff-checkpoint-3";
+  const std::string now = "sheardiff-checkpoint-5", before = "sheardiff-checkpoint-3";
   ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
   std::memcpy(bytes.data() + 8, before.data(), before.size());  // the CRC covers the payload only
   write_bytes(root / "old" / "checkpoint.bin", bytes);

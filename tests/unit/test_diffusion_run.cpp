@@ -1,9 +1,12 @@
-// The in-run diffusion observer and `sheardiff analyse DIR` (reanalyse_run) see the same frames
-// and give the same numbers, to the bit.
+// The in-run observers and `sheardiff analyse DIR` (reanalyse_run) see the same frames and give
+// the same numbers, to the bit; where they would not, analyse writes beside the run's files.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/simulation.hpp"
@@ -29,9 +32,13 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   const nlohmann::json during = run_to_directory(c, dir, false);
   ASSERT_TRUE(during.contains("D"));
   ASSERT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
-  const nlohmann::json after = reanalyse_run(dir);
-  for (const char* key : {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
-                          "msd_window_slope", "analysis_frames", "diffusion_consistency"})
+  const Reanalysis re = reanalyse_run(dir);
+  EXPECT_TRUE(re.differs.empty());
+  EXPECT_EQ(re.folder, dir);
+  const nlohmann::json& after = re.summary;
+  for (const char* key :
+       {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
+        "msd_window_slope", "analysis_frames", "diffusion_consistency"})
     EXPECT_EQ(during[key], after[key]) << key;
   // Physical sanity of the numbers themselves: a sheared suspension diffuses and fluctuates.
   EXPECT_GT(during["D"].get<double>(), 0.0);
@@ -40,6 +47,126 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   // Frames are written at the first step past each multiple of 0.01, so the one at 0.3 lies just
   // past the transient: 0.30, 0.31, ..., 1.50.
   EXPECT_EQ(during["analysis_frames"].get<long>(), 121);
+  std::filesystem::remove_all(dir);
+}
+
+std::string file_text(const std::filesystem::path& f) {
+  std::ifstream in(f);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A small pressure cell that reaches its (loosely tested) steady state within a few strains.
+Config small_cell(bool diffusion) {
+  Config c;
+  c.scene.type = "pressure_shear";
+  c.particles.n = 60;
+  c.particles.phi_init = 0.74;
+  c.flow.j = 1e-2;
+  c.contact.ktilde = 1e3;
+  c.run.seed = 3;
+  c.run.strain = 6.0;
+  c.steady.window = 1.0;
+  c.steady.h_tolerance = 0.05;
+  c.steady.mu_tolerance = 0.3;
+  c.steady.measure_strain = 2.0;
+  c.output.frame_strain = 0.02;
+  c.analysis.error_block = 0.5;
+  c.analysis.diffusion = diffusion;
+  c.analysis.msd_window_lo = 0.2;
+  c.analysis.msd_window_hi = 0.5;
+  c.analysis.reference_times = 30;
+  c.analysis.vacf_max_lag = 0.3;
+  return c;
+}
+
+// Every key of the pressure cell's summary (the steady window's error bars and stationarity
+// signals, from the frames the observer sampled, the detection frame included) comes out of
+// analyse unchanged, so summary.json and analysis.h5 are left as they are.
+TEST(DiffusionRun, AnalyseReproducesThePressureCellExactly) {
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_cell";
+  std::filesystem::remove_all(dir);
+  const nlohmann::json during = run_to_directory(small_cell(true), dir, false);
+  ASSERT_TRUE(during["steady"].get<bool>());
+  ASSERT_TRUE(during["phi_err"].is_number()) << during.dump();
+  ASSERT_TRUE(during.contains("mu_top_minus_bottom_err"));
+  const std::string before = file_text(dir / "summary.json");
+  const auto h5_time = std::filesystem::last_write_time(dir / "analysis.h5");
+  const Reanalysis re = reanalyse_run(dir);
+  EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
+  for (const auto& [key, value] : during.items()) EXPECT_EQ(value, re.summary[key]) << key;
+  EXPECT_EQ(file_text(dir / "summary.json"), before);
+  EXPECT_EQ(std::filesystem::last_write_time(dir / "analysis.h5"), h5_time);
+  EXPECT_FALSE(std::filesystem::exists(dir / "reanalysis"));
+
+  // A summary that disagrees with the trajectory (here an edited error bar; in practice an
+  // older version's numbers) is never overwritten: the analysis goes beside it.
+  nlohmann::json edited = during;
+  edited["phi_err"] = 1.0;
+  { std::ofstream(dir / "summary.json") << edited.dump(); }
+  const std::string edited_text = file_text(dir / "summary.json");
+  const Reanalysis beside = reanalyse_run(dir);
+  EXPECT_EQ(beside.differs, std::vector<std::string>{"phi_err"});
+  EXPECT_EQ(beside.folder, dir / "reanalysis");
+  EXPECT_EQ(file_text(dir / "summary.json"), edited_text);
+  EXPECT_EQ(std::filesystem::last_write_time(dir / "analysis.h5"), h5_time);
+  ASSERT_TRUE(std::filesystem::exists(dir / "reanalysis" / "analysis.h5"));
+  const auto written = nlohmann::json::parse(file_text(dir / "reanalysis" / "summary.json"));
+  EXPECT_EQ(written["phi_err"], during["phi_err"]);
+  std::filesystem::remove_all(dir);
+}
+
+// A run made without the diffusion analysis gets it from analyse: its keys are added and
+// analysis.h5 written, the run's own keys stay as they were.
+TEST(DiffusionRun, AnalyseAddsWhatTheRunDidNotCompute) {
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_adds";
+  std::filesystem::remove_all(dir);
+  const nlohmann::json during = run_to_directory(small_cell(false), dir, false);
+  ASSERT_TRUE(during["steady"].get<bool>());
+  ASSERT_FALSE(during.contains("D"));
+  ASSERT_FALSE(std::filesystem::exists(dir / "analysis.h5"));
+  const Reanalysis re = reanalyse_run(dir);
+  EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
+  EXPECT_EQ(re.folder, dir);
+  const auto written = nlohmann::json::parse(file_text(dir / "summary.json"));
+  for (const auto& [key, value] : during.items()) EXPECT_EQ(value, written[key]) << key;
+  EXPECT_TRUE(written.contains("D"));
+  EXPECT_TRUE(written.contains("analysed_by"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
+  std::filesystem::remove_all(dir);
+}
+
+// A window of fewer than 8 frames has no error bars: the summary says why (no "+- nan"), and
+// analyse, counting the same frames, agrees.
+TEST(DiffusionRun, TooFewFramesForErrorBarsIsSaidAndReproduced) {
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_few";
+  std::filesystem::remove_all(dir);
+  Config c = small_cell(false);
+  c.output.frame_strain = 0.25;
+  c.steady.measure_strain = 1.0;
+  const nlohmann::json during = run_to_directory(c, dir, false);
+  ASSERT_TRUE(during["steady"].get<bool>());
+  EXPECT_FALSE(during.contains("phi_err"));
+  ASSERT_TRUE(during.contains("steady_errors_note"));
+  EXPECT_NE(during["steady_errors_note"].get<std::string>().find("frames in the measured window"),
+            std::string::npos);
+  const Reanalysis re = reanalyse_run(dir);
+  EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
+  EXPECT_FALSE(re.summary.contains("phi_err"));
+  std::filesystem::remove_all(dir);
+}
+
+// The channel has no diffusion analysis: analyse refuses its run before reading anything.
+TEST(DiffusionRun, AnalyseRefusesAChannelRun) {
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_channel";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  { std::ofstream(dir / "config.toml") << "[scene]\ntype = \"channel\"\n"; }
+  { std::ofstream(dir / "summary.json") << "{\"steps\": 1}"; }
+  EXPECT_THROW(reanalyse_run(dir), ConfigError);
+  EXPECT_EQ(file_text(dir / "summary.json"), "{\"steps\": 1}");
+  EXPECT_FALSE(std::filesystem::exists(dir / "analysis.h5"));
   std::filesystem::remove_all(dir);
 }
 

@@ -98,5 +98,36 @@ TEST(InitialConfiguration, FromTableAndFromH5mdFrame) {
   std::filesystem::remove_all(dir);
 }
 
+// Two discs at one spot stopped the run at step 0 with advice about integrator settings (issue
+// 35, case 10). Coincident discs, and discs overlapping across the periodic edge, are refused as
+// bad input naming the pair; a run's own overlaps (~1/ktilde) are not.
+TEST(InitialConfiguration, OverlappingDiscsInAFileAreRefused) {
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_init_overlap";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Config c;
+  c.particles.n = 4;
+  c.particles.phi_init = 0.2;  // Lx = Ly = 4.82 d
+  c.particles.init_file = (dir / "start.txt").string();
+  const auto refused = [&](const std::string& table, const std::string& pair) {
+    { std::ofstream(dir / "start.txt") << table; }
+    try {
+      validate_run_inputs(c, "test");
+      ADD_FAILURE() << "accepted:\n" << table;
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("particles.init_file"), std::string::npos) << m;
+      EXPECT_NE(m.find(pair), std::string::npos) << m;
+    }
+  };
+  refused("1 1 1\n4 1 1.4\n1 4 1\n1 4 1\n", "particles 2 and 3");
+  // x = 0.1 and 4.47 are 0.45 d apart through the periodic edge.
+  refused("0.1 1 1\n2.5 1 1.4\n4.47 1 1\n2.5 3.5 1.4\n", "particles 0 and 2");
+  // Touching with a 1 % overlap (a dense run's last frame) is a start.
+  { std::ofstream(dir / "start.txt") << "1 1 1\n1.99 1 1\n1 3 1.4\n3 3 1.4\n"; }
+  EXPECT_NO_THROW(validate_run_inputs(c, "test"));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sheardiff

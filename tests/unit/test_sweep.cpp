@@ -254,6 +254,7 @@ void fake_finished(const SweepSpec& spec, const SweepPoint& p, const fs::path& o
   std::ofstream(dir / "config.toml") << to_toml(cfg);
   const double J = cfg.flow.j;
   const nlohmann::json s = {{"J", J},
+                            {"seed", cfg.run.seed},
                             {"steady", true},
                             {"phi", 0.81 - 0.64 * std::sqrt(J) + 0.002 * noise},
                             {"mu", 0.3 + 0.9 * std::pow(J, 0.4)},
@@ -317,6 +318,39 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
   std::ofstream(spec.results / "points" / points[0].name / "config.toml")
       << to_toml(load_config(spec.base, points[5].overrides));
   EXPECT_THROW(stored_point(spec, points[0]), ConfigError);
+}
+
+// Issue 35, case 4: a sweep over part of the points, collected into the folder of the whole,
+// rewrote its sweep.csv and fits.json with that part alone. The folder's other finished points
+// stay in both, with their axis values, and the fits come out as the whole sweep's.
+TEST(Sweep, APartialSweepKeepsTheFoldersOtherPointsInItsTables) {
+  const auto file = write_files("partial",
+                                "[sweep]\nbase = \"base.toml\"\n"
+                                "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
+                                "\"run.seed\" = [1, 2, 3]\n");
+  const auto spec = load_sweep(file);
+  const auto out = file.parent_path() / "out";
+  const double noise[] = {-1.0, 0.3, 0.7};
+  for (const auto& p : expand_points(spec)) fake_finished(spec, p, out, noise[p.index % 3]);
+  const auto whole = collect_sweep(spec, out);
+  const auto rows = [&] {
+    std::ifstream in(out / "sweep.csv");
+    std::string line;
+    long n = -1;
+    while (std::getline(in, line)) ++n;
+    return n;
+  };
+  ASSERT_EQ(rows(), 12);
+  const auto part = file.parent_path() / "part.toml";
+  std::ofstream(part) << "[sweep]\nbase = \"base.toml\"\n"
+                         "[sweep.axes]\n\"flow.J\" = [1e-3]\n\"run.seed\" = [2]\n";
+  const auto again = collect_sweep(load_sweep(part), out);
+  EXPECT_EQ(rows(), 12);
+  EXPECT_EQ(again["finished"].get<long>(), 12);
+  ASSERT_EQ(again["groups"].size(), 1u);
+  EXPECT_EQ(again["groups"][0]["fits"], whole["groups"][0]["fits"]);
+  EXPECT_EQ(again["groups"][0]["rows"].size(), 4u);
+  fs::remove_all(file.parent_path());
 }
 
 // A refit over two stores: the re-measured store (listed first) replaces the older one's J, a

@@ -69,7 +69,9 @@ class Dynamics {
   void finish_step() { ++steps_; }
 
   // Everything that evolves (for checkpoints); loading re-derives the matrix pattern.
-  void serialize(Archive& a);
+  // fluid_pattern: the state holds the heights the fluid layer's pattern was built from
+  // (checkpoint layout 5 on; without them a channel run resumes, but not bit-identically).
+  void serialize(Archive& a, bool fluid_pattern = true);
 
   struct Saved {
     std::vector<Vec2> position, unwrapped;

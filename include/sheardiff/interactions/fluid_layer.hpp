@@ -40,8 +40,8 @@ class FluidLayer {
   double node_y(int k) const { return y_lo_ + k * h_; }
 
   // The entries (row >= col, global indices) the layer adds to a system whose fluid unknowns
-  // start at `base`, for the mobile particles at their current heights.
-  std::vector<std::pair<int, int>> pattern(const Particles& p, int dof, int base) const;
+  // start at `base`, for mobile particles at heights y (one per mobile particle).
+  std::vector<std::pair<int, int>> pattern(const std::vector<double>& y, int dof, int base) const;
   // Adds the layer's blocks and right-hand side (the particles' drag on the fluid against the
   // reference flow, the fluid's viscous term and the reference profile's pressure gradient G0).
   void assemble(const Particles& p, const ImposedFlow& reference, int dof, int base,

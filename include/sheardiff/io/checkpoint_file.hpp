@@ -1,7 +1,7 @@
 #pragma once
 // The file format of DIR/checkpoint.bin: a header, then the run's archived state (Archive).
 //
-//   u64 22, "sheardiff-checkpoint-4"   (the magic, as Archive writes a string; the digit is
+//   u64 22, "sheardiff-checkpoint-5"   (the magic, as Archive writes a string; the digit is
 //                                        the layout of the state that follows)
 //   u64 payload length in bytes
 //   u32 CRC-32 (zlib) of the payload
@@ -11,7 +11,9 @@
 // still read, unchecked, so that runs started by an older sheardiff can be resumed. Layouts 2
 // and 3 hold the pressure cell's gap profiles inside its own section; from layout 4 they are
 // the profiles observer's: a pressure-cell run of layout 2 or 3 is refused with that reason
-// (CheckpointStore), a simple-shear one resumes.
+// (CheckpointStore), a simple-shear one resumes. Layout 5 adds, for the channel alone, the
+// heights its fluid layer's sparsity pattern was built from (ForceBalance::on_rebuild): a
+// layout-4 channel checkpoint resumes, not bit-identically.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -34,7 +36,7 @@ std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload);
 struct CheckpointPayload {
   std::vector<char> bytes;  // the archived state, after the magic
   bool checksummed = true;  // false: a version 2 file, read without a check
-  int layout = 4;           // the state layout: 2, 3 or 4 (the magic's digit)
+  int layout = 5;           // the state layout: 2 to 5 (the magic's digit)
 };
 
 // Reads and checks FILE: the magic, the length against the file size, the CRC. Throws

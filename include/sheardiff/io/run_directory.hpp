@@ -36,6 +36,9 @@ class RunDirectory {
   const std::filesystem::path& path() const { return dir_; }
   std::filesystem::path file(const std::string& name) const { return dir_ / name; }
   RunState state() const;
+  // Whether DIR no longer names the directory this object locked (it was renamed or removed
+  // while the command ran); then state() reports what the moved directory holds.
+  bool moved() const;
   // The run files present, for messages ("config.toml, trajectory.h5").
   std::string run_files_present() const;
 

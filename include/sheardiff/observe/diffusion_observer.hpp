@@ -1,6 +1,7 @@
 #pragma once
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "sheardiff/analysis/diffusion.hpp"
@@ -37,8 +38,19 @@ class DiffusionObserver final : public Observer {
   std::vector<double> bottom_, top_;  // wall centre lines per frame (scenes with walls)
 };
 
-// Recomputes the diffusion analysis of a finished run from DIR/trajectory.h5, DIR/config.toml
-// and DIR/summary.json alone; rewrites DIR/analysis.h5 and the analysis keys of summary.json.
-nlohmann::json reanalyse_run(const std::filesystem::path& dir);
+// What `sheardiff analyse DIR` found: the run's summary with every recomputed key, and where it
+// went. Keys the run lacked (a run without the diffusion analysis, an older version's) are
+// added to DIR/summary.json, and analysis.h5 is written if the run has none. If a key the run
+// has comes out different, nothing of the run's is touched: the summary and analysis.h5 go to
+// DIR/reanalysis/ and `differs` names those keys.
+struct Reanalysis {
+  nlohmann::json summary;
+  std::vector<std::string> differs;
+  std::filesystem::path folder;  // DIR, or DIR/reanalysis when `differs` is not empty
+};
+
+// Recomputes the analysis of a finished run from DIR/trajectory.h5, DIR/config.toml and
+// DIR/summary.json alone.
+Reanalysis reanalyse_run(const std::filesystem::path& dir);
 
 }  // namespace sheardiff

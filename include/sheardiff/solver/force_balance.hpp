@@ -77,8 +77,14 @@ class ForceBalance {
                   : flow.max_shear_rate();
   }
 
-  // The neighbour list changed: new sparsity pattern and symbolic analysis.
-  void on_rebuild(const Particles& p, const std::vector<Pair>& pairs);
+  // The neighbour list changed: new sparsity pattern and symbolic analysis. With a fluid layer
+  // the pattern depends on the particles' heights at the rebuild, kept for checkpoints; a
+  // restored run passes restored = true to build it from those (checkpoint layout 5) rather
+  // than from the positions at the checkpoint, so that its solves are bit-identical.
+  void on_rebuild(const Particles& p, const std::vector<Pair>& pairs, bool restored = false);
+  void serialize_fluid_pattern(Archive& a) {
+    if (fluid_) a.io(pattern_y_);
+  }
   // Open/close contacts from the current geometry (a new contact starts with a fresh history).
   static void update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs);
   // The laws' per-pair histories over a step of length dt with velocities u, at the positions
@@ -153,6 +159,7 @@ class ForceBalance {
   std::vector<PairTerm> terms_;
   VecX u_;
   VecX fluid_load_;  // the pressure gradient's generalised force on the fluid unknowns
+  std::vector<double> pattern_y_;  // the mobile particles' heights at the last rebuild (fluid)
   double residual_ = 0.0;
   bool check_residual_ = false;
   StickingCounts sticking_;

@@ -3,13 +3,18 @@
 // points, the local process pool, the Slurm job array, and the collection into sweep.csv and
 // fits.json. Every point is an ordinary run directory DIR/points/<name>/ (docs/sweeps.md).
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "sheardiff/config.hpp"
+
 namespace sheardiff {
+
+class RunDirectory;
 
 struct SweepSpec {
   std::filesystem::path file;  // the sweep file itself (absolute)
@@ -65,10 +70,17 @@ enum class PointState { finished, resumable, fresh };
 PointState point_state(const SweepSpec& spec, const SweepPoint& p,
                        const std::filesystem::path& out_dir);
 
+// A point another process is running (its lock is held): not a failure of the point.
+struct PointBusy : ConfigError {
+  using ConfigError::ConfigError;
+};
+
 // Runs one point to its end in this process (resuming, or starting afresh over the remains of
-// a start killed before its first checkpoint, as its state says), in its run directory's lock.
-// Throws what run_to_directory throws.
-void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir);
+// a start killed before its first checkpoint, as its state says), in its run directory's lock;
+// `report` (if given) is called with the summary while the run directory's log is open.
+// Throws PointBusy if another process runs the point, else what run_to_directory throws.
+void run_point(const SweepSpec& spec, const SweepPoint& p, const std::filesystem::path& out_dir,
+               const std::function<void(const RunDirectory&, const nlohmann::json&)>& report = {});
 
 // Local backend: `jobs` worker processes of `exe sweep FILE --out DIR --point I`, progress
 // lines on stderr if `progress` (with an ISO 8601 UTC timestamp off a terminal), SIGINT/SIGTERM
