@@ -110,6 +110,7 @@ void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
   f.tilt = d.box().le_offset;
   f.position = &d.particles().position;
   f.unwrapped = &d.particles().unwrapped;
+  if (d.particles().image.size() == d.particles().size()) f.image = &d.particles().image;
   f.velocity = &run.sim.integrator().velocities().u;
   f.observables = values;
   ContactNetwork contacts;

@@ -153,7 +153,7 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 
-void Dynamics::serialize(Archive& a, bool fluid_pattern) {
+void Dynamics::serialize(Archive& a, bool layout5) {
   a.tag("dynamics");
   a.io(particles_.position);
   a.io(particles_.unwrapped);
@@ -172,13 +172,34 @@ void Dynamics::serialize(Archive& a, bool fluid_pattern) {
   }
   a.io(wall_state);
   if (a.loading() && walls_) walls_->driven_vx = wall_state[0];
+  if (layout5) {
+    a.tag("images");
+    particles_.image.resize(particles_.size(), {0, 0});
+    a.io(particles_.image);
+  } else if (a.loading()) {
+    estimate_images();
+  }
   neighbours_.serialize(a);
-  if (fluid_pattern) force_balance_.serialize_fluid_pattern(a);
-  if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs(), fluid_pattern);
+  if (layout5) force_balance_.serialize_fluid_pattern(a);
+  if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs(), layout5);
+}
+
+void Dynamics::estimate_images() {
+  // Exact in y and without Lees-Edwards; in x under Lees-Edwards the nearest count, which is
+  // what a checkpoint of an earlier layout (no counts) can give.
+  Particles& p = particles_;
+  p.image.assign(p.size(), {0, 0});
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double iy =
+        box_.lees_edwards ? std::round((p.unwrapped[i].y() - p.position[i].y()) / box_.ly) : 0.0;
+    const double ix =
+        std::round((p.unwrapped[i].x() - p.position[i].x() - iy * box_.le_offset) / box_.lx);
+    p.image[i] = {static_cast<int>(ix), static_cast<int>(iy)};
+  }
 }
 
 Dynamics::Saved Dynamics::save() const {
-  Saved s{particles_.position, particles_.unwrapped, {}, box_, time_};
+  Saved s{particles_.position, particles_.unwrapped, particles_.image, {}, box_, time_};
   s.contacts.reserve(neighbours_.pairs().size());
   for (const Pair& pr : neighbours_.pairs()) s.contacts.push_back(pr.history);
   return s;
@@ -187,6 +208,7 @@ Dynamics::Saved Dynamics::save() const {
 void Dynamics::restore(const Saved& s) {
   particles_.position = s.position;
   particles_.unwrapped = s.unwrapped;
+  particles_.image = s.image;
   box_ = s.box;
   time_ = s.time;
   auto& pairs = neighbours_.pairs();

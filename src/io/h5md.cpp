@@ -875,11 +875,20 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   flatten2(pos);
   m.position.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
   if (m.unwrapped) {
-    // position + image . edges: exact in y; in x the Lees-Edwards shift moved on since each
-    // crossing, which is why the integrated displacement is kept beside it.
+    // position + image . edges is continuous in time (the convention of LAMMPS and GSD): the
+    // engine's counts of the images crossed, re-expressed for the reduced tilt of `edges`
+    // (tilt = offset - m lx adds m to the x count of each y image). It equals the unwrapped
+    // position in y; in x the two differ by the Lees-Edwards shift gained since each crossing.
     const std::vector<Vec2>& u = *frame.unwrapped;
     std::vector<std::int32_t> img(2 * n);
+    const double m_tilt = m.layout.lees_edwards ? std::round(frame.tilt / lx) : 0.0;
     for (std::size_t i = 0; i < n; ++i) {
+      if (frame.image != nullptr) {
+        const auto [ix, iy] = (*frame.image)[i];
+        img[2 * i] = static_cast<std::int32_t>(ix + static_cast<int>(m_tilt) * iy);
+        img[2 * i + 1] = static_cast<std::int32_t>(iy);
+        continue;
+      }
       const double iy = m.layout.lees_edwards ? std::round((u[i].y() - pos[i].y()) / ly) : 0.0;
       img[2 * i] = static_cast<std::int32_t>(std::round((u[i].x() - pos[i].x() - iy * tilt) / lx));
       img[2 * i + 1] = static_cast<std::int32_t>(iy);

@@ -41,15 +41,21 @@ std::uint64_t pair_key(int i, int j) {
 
 void NeighbourList::rebuild(Particles& p, const Box& box) {
   const std::size_t n = p.size();
-  // Wrap into the primary cell; a Lees-Edwards crossing in y shifts x by the offset.
+  // Wrap into the primary cell; a Lees-Edwards crossing in y shifts x by the offset. The
+  // images crossed are counted, so that the trajectory's position + image . edges is continuous.
+  if (p.image.size() != n) p.image.assign(n, {0, 0});
   for (std::size_t k = 0; k < n; ++k) {
     Vec2& x = p.position[k];
+    double ny = 0.0;
     if (box.lees_edwards) {
-      const double ny = std::floor(x.y() / box.ly);
+      ny = std::floor(x.y() / box.ly);
       x.y() -= ny * box.ly;
       x.x() -= ny * box.le_offset;
     }
-    x.x() -= std::floor(x.x() / box.lx) * box.lx;
+    const double nx = std::floor(x.x() / box.lx);
+    x.x() -= nx * box.lx;
+    p.image[k][0] += static_cast<int>(nx);
+    p.image[k][1] += static_cast<int>(ny);
   }
 
   double amax = 0.0;

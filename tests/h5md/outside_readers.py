@@ -4,7 +4,11 @@
 Runs a small simple-shear and a small pressure-cell run (contact network on), then
 1. the independent H5MD 1.1 checker (tests/h5md/h5md_check.py, units required) must pass on
    both, and must fail on a copy whose box/edges step is a copy rather than a hard link;
-2. the GSD export (tools/h5md_to_gsd.py) read back with the gsd package: the box of every frame
+2. position + image . edges continuous in time over many Lees-Edwards crossings (the convention
+   of LAMMPS and GSD), in the H5MD file and in its GSD export (issue 34: the image used to be
+   the one nearest the unwrapped position, which jumped by Lx once the shift gained since a
+   crossing passed Lx/2);
+3. the GSD export (tools/h5md_to_gsd.py) read back with the gsd package: the box of every frame
    must be the H5MD one (Lx, Ly, tilt = xy Ly), and the minimum-image overlaps found under that
    box must be the simulation's (largest overlap at most the run's health limit, every pair of
    /connectivity/contacts within contact distance), while the same positions under the box
@@ -61,6 +65,22 @@ measure_strain = 0.3
 [output]
 frame_strain = 0.05
 contacts = true
+"""
+LONG = """[scene]
+type = "simple_shear"
+[particles]
+N = 100
+phi_init = 0.78
+[flow]
+J = 1e-2
+[run]
+strain = 6.0
+seed = 3
+transient_strain = 0.1
+[analysis]
+diffusion = false
+[output]
+frame_strain = 0.01
 """
 GENUINE = 0.1  # d: health.max_overlap, the largest overlap a run may have
 failures = []
@@ -168,6 +188,56 @@ def check_gsd(root, traj, periodic_y):
         expect(false_pairs > 0, f"{name}: the box without its tilt shows false overlaps (the check has teeth)")
 
 
+def check_continuity(root, traj):
+    """position + image . edges moves by less than a tenth of the cell per frame, equals the
+    unwrapped position in y, and stays so through the GSD export; the nearest-image convention
+    on the same frames jumps (the check has teeth)."""
+    with h5py.File(traj, "r") as f:
+        g = f["particles/suspension"]
+        pos = g["position/value"][()]
+        img = g["image/value"][()].astype(np.float64)
+        edges = g["box/edges/value"][()]
+        unw = g["unwrapped_position/value"][()]
+    x = pos + img[:, :, :1] * edges[:, None, 0, :] + img[:, :, 1:] * edges[:, None, 1, :]
+    lx, ly = edges[0, 0, 0], edges[0, 1, 1]
+    step = np.abs(np.diff(x, axis=0))
+    crossings = int(np.sum(np.abs(np.diff(img[:, :, 1], axis=0))))
+    print(f"      {len(x)} frames, {crossings} crossings of the y edge, largest move per frame "
+          f"{step.max():.3f} d")
+    expect(crossings > 50, f"{traj.parent.name}: the run crosses the Lees-Edwards edge often ({crossings})")
+    expect(step.max() < 0.1 * lx, f"{traj.parent.name}: position + image . edges is continuous")
+    expect(np.abs(x[:, :, 1] - unw[:, :, 1]).max() < 1e-9 * ly,
+           f"{traj.parent.name}: position + image . edges equals the unwrapped position in y")
+    # The nearest image of the unwrapped position, the convention this replaced.
+    tilt = edges[:, None, 1, 0]
+    iy = np.round((unw[:, :, 1] - pos[:, :, 1]) / ly)
+    ix = np.round((unw[:, :, 0] - pos[:, :, 0] - iy * tilt) / lx)
+    jumps = int(np.sum(np.abs(np.diff(pos[:, :, 0] + ix * lx + iy * tilt, axis=0)) > 0.5 * lx))
+    print(f"      the nearest-image convention on the same frames: {jumps} jumps of about Lx")
+    expect(jumps > 0, f"{traj.parent.name}: the nearest-image convention jumps here (the check has teeth)")
+    try:
+        import gsd.hoomd
+    except ImportError:
+        return
+    out = traj.with_suffix(".gsd")
+    subprocess.run([sys.executable, str(root / "tools" / "h5md_to_gsd.py"), str(traj), "--out", str(out)],
+                   check=True, capture_output=True)
+    try:
+        t = gsd.hoomd.open(name=str(out), mode="r")
+    except ValueError:
+        t = gsd.hoomd.open(name=str(out), mode="rb")
+    with t:
+        xs = []
+        for fr in t:
+            lx_, ly_, _, xy = (float(v) for v in fr.configuration.box[:4])
+            r = fr.particles.position[:, :2].astype(np.float64)
+            im = fr.particles.image[:, :2].astype(np.float64)
+            xs.append(r + im[:, :1] * np.array([lx_, 0.0]) + im[:, 1:] * np.array([xy * ly_, ly_]))
+    gstep = np.abs(np.diff(np.array(xs), axis=0)).max()
+    expect(gstep < 0.1 * lx, f"{traj.parent.name}: the GSD export's position + image . box is continuous "
+                             f"(largest move per frame {gstep:.3f} d)")
+
+
 def check_plot_tools(root, work, runs):
     """The plot tools draw both runs (no analysis.h5 in either) and end with one line, not a
     traceback, when their input is missing."""
@@ -210,6 +280,7 @@ def main():
     else:
         check_gsd(args.root, simple, True)
         check_gsd(args.root, pressure, False)
+    check_continuity(args.root, run(args.bin, args.work, "simple_shear_long", LONG))
     check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
     print(f"{len(failures)} failed")
     sys.exit(1 if failures else 0)

@@ -2,6 +2,7 @@
 // from its checkpoint ends in the same state, to the bit, as a run that was never stopped.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -306,6 +307,42 @@ TEST(Checkpoint, MessagesNameTheFileAndWhereTheRunWent) {
   fs::remove_all(root);
 }
 
+// The trajectory's image counts, every frame.
+std::vector<int> image_counts(const fs::path& traj) {
+  const hid_t f = H5Fopen(traj.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, "/particles/suspension/image/value", H5P_DEFAULT);
+  const hid_t sp = H5Dget_space(d);
+  std::vector<int> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(sp)));
+  H5Dread(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(sp);
+  H5Dclose(d);
+  H5Fclose(f);
+  return v;
+}
+
+// Issue 34: the image counts are state (the Lees-Edwards shift gained since each crossing is
+// not in the positions), kept in the checkpoint: a simple-shear run stopped late and resumed
+// writes the images of the run never stopped.
+TEST(Checkpoint, ImageCountsSurviveAResume) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_images";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root, "simple_shear");
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
+  const auto whole = std::chrono::steady_clock::now() - t0;
+  const pid_t pid = spawn(cfg, root / "stopped");
+  std::this_thread::sleep_for(whole * 7 / 10);
+  kill(pid, SIGTERM);
+  const int code = wait_exit(pid);
+  if (code == 0) GTEST_SKIP() << "the run finished before SIGTERM landed";
+  ASSERT_EQ(code, 128 + SIGTERM);
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
+  const auto a = image_counts(root / "whole" / "trajectory.h5");
+  EXPECT_EQ(a, image_counts(root / "stopped" / "trajectory.h5"));
+  EXPECT_NE(std::count(a.begin(), a.end(), 0), static_cast<long>(a.size())) << "no crossing";
+  fs::remove_all(root);
+}
+
 // Issue 35, case 3: channel runs resumed 1e-13 d off in the first frame after the checkpoint and
 // 2e-6 d later: the fluid layer's sparsity pattern was rebuilt from the positions at the
 // checkpoint instead of those at the last neighbour rebuild, so CHOLMOD ordered another matrix.
@@ -440,12 +477,18 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   const std::size_t header = 8 + 22 + 8 + 4,
                     counters = 4 * sizeof(std::size_t) + 8 + 4 * sizeof(long);
   ASSERT_GT(v3.size(), header + counters);
+  // Layout 5 added the image counts (80 discs) as their own section, which version 2 lacks.
+  const std::string images = "images";
+  const auto at = std::search(v3.begin(), v3.end(), images.begin(), images.end());
+  ASSERT_NE(at, v3.end());
+  std::vector<char> v4(v3.begin(), at - 8);
+  v4.insert(v4.end(), at + static_cast<long>(images.size() + 8 + 80 * 8), v3.end());
   std::vector<char> v2(8);
   const std::uint64_t magic_length = 22;
   std::memcpy(v2.data(), &magic_length, 8);
   const std::string magic = "sheardiff-checkpoint-2";
   v2.insert(v2.end(), magic.begin(), magic.end());
-  v2.insert(v2.end(), v3.begin() + header, v3.end() - counters);
+  v2.insert(v2.end(), v4.begin() + header, v4.end() - counters);
   write_bytes(root / "old" / "checkpoint.bin", v2);
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0);
   EXPECT_NE(text_of(root / "err.txt").find("has no checksum"), std::string::npos);

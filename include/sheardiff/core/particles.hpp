@@ -1,4 +1,5 @@
 #pragma once
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -17,8 +18,12 @@ struct Particles {
   std::size_t n_mobile = 0;
   std::vector<Vec2> position;   // current centres (wrapped at neighbour rebuilds)
   std::vector<Vec2> unwrapped;  // centres integrated without wrapping (for displacements)
-  std::vector<double> radius;   // a_i = d_i / 2
-  std::vector<int> species;     // 0 small, 1 large
+  // Periodic images crossed at the wraps (x, y), as LAMMPS counts them: position + ix (lx, 0)
+  // + iy (le_offset, ly) is continuous in time, Lees-Edwards crossings included (the trajectory's
+  // image). Empty until the first wrap (then all zero from the start).
+  std::vector<std::array<int, 2>> image;
+  std::vector<double> radius;  // a_i = d_i / 2
+  std::vector<int> species;    // 0 small, 1 large
   std::vector<Motion> motion;
   std::vector<Vec3> velocity;  // last solved (u_x, u_y, omega)
   // Optional imposed force and torque on mobile particles (empty = none); tests and

@@ -69,17 +69,21 @@ class Dynamics {
   void finish_step() { ++steps_; }
 
   // Everything that evolves (for checkpoints); loading re-derives the matrix pattern.
-  // fluid_pattern: the state holds the heights the fluid layer's pattern was built from
-  // (checkpoint layout 5 on; without them a channel run resumes, but not bit-identically).
-  void serialize(Archive& a, bool fluid_pattern = true);
+  // layout5: the state holds the particles' image counts and the heights the fluid layer's
+  // pattern was built from (checkpoint layout 5 on). Without them the images are estimated
+  // from the unwrapped positions, and a channel run resumes, but not bit-identically.
+  void serialize(Archive& a, bool layout5 = true);
 
   struct Saved {
     std::vector<Vec2> position, unwrapped;
+    std::vector<std::array<int, 2>> image;
     std::vector<PairHistory> contacts;
     Box box;
     double time;
   };
   Saved save() const;
+  // Image counts from the unwrapped positions (for a checkpoint that has none).
+  void estimate_images();
   // Undo moves made since save() with allow_rebuild = false.
   void restore(const Saved& s);
 

@@ -40,8 +40,8 @@ struct TrajectoryLayout {
   std::vector<std::string> observable_units;
   // /h5md/author@name; empty: $SHEARDIFF_AUTHOR, else the account's name, else "unknown"
   std::string author;
-  std::string creator_version;           // e.g. "0.1.0"
-  std::string config_toml;               // resolved config text, stored as /parameters@config
+  std::string creator_version;  // e.g. "0.1.0"
+  std::string config_toml;      // resolved config text, stored as /parameters@config
 };
 
 struct FrameData {
@@ -51,9 +51,12 @@ struct FrameData {
   double tilt = 0;        // Lees-Edwards shift of the image at +ly (any multiple of lx added)
   const std::vector<Vec2>* position = nullptr;   // wrapped positions, required
   const std::vector<Vec2>* unwrapped = nullptr;  // optional; only honoured if given at frame 0
-  const std::vector<Vec3>* velocity = nullptr;   // (u_x,u_y,omega), required if write_velocity
-  const ContactNetwork* contacts = nullptr;      // required if write_contacts
-  std::vector<double> observables;               // same order as layout.observables
+  // The images crossed (x, y) with respect to the unwrapped Lees-Edwards offset `tilt`
+  // (Particles::image); without them the image is the nearest to the unwrapped position.
+  const std::vector<std::array<int, 2>>* image = nullptr;
+  const std::vector<Vec3>* velocity = nullptr;  // (u_x,u_y,omega), required if write_velocity
+  const ContactNetwork* contacts = nullptr;     // required if write_contacts
+  std::vector<double> observables;              // same order as layout.observables
 };
 
 class H5mdWriter {
