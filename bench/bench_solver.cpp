@@ -16,6 +16,7 @@
 #endif
 
 #include "sheardiff/simulation.hpp"
+#include "sheardiff/solver/detail/cholmod_tuning.hpp"
 #include "sheardiff/solver/sparse_cholesky.hpp"
 
 namespace {

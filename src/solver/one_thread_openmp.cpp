@@ -8,8 +8,8 @@
 // and closes it with a barrier whose wake-up is a futex system call. perf put 30 % of a running
 // N = 1000, J = 1e-4 sweep point in libgomp and the kernel's futex path; two runs sharing the
 // 2 cores, as a sweep's workers do, take 1.65-1.82x less wall time without it
-// (bench/two_workers.sh, docs/performance.md "Issue 13"), one run alone on an idle machine
-// 1.0-1.5x less.
+// (bench/two_workers.sh, docs/performance.md "What cut the cost per strain"), one run alone on an
+// idle machine 1.0-1.5x less.
 //
 // This definition is found before libgomp's by the dynamic linker (the executable comes first
 // in the lookup order, and CHOLMOD's reference exports it from there). With one thread it runs

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "sheardiff/solver/detail/cholmod_tuning.hpp"
+
 // OpenBLAS (behind CHOLMOD's supernodal kernels) would start one thread per core; sheardiff
 // runs one process per core in sweeps, so its BLAS stays single-threaded. Weak: absent with
 // other BLAS implementations.

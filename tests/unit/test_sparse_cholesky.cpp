@@ -6,6 +6,7 @@
 #include <Eigen/CholmodSupport>
 
 #include "sheardiff/simulation.hpp"
+#include "sheardiff/solver/detail/cholmod_tuning.hpp"
 #include "sheardiff/solver/sparse_cholesky.hpp"
 
 namespace sheardiff {

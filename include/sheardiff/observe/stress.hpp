@@ -1,6 +1,6 @@
 #pragma once
+#include "sheardiff/core/contact_network.hpp"
 #include "sheardiff/integrator/dynamics.hpp"
-#include "sheardiff/io/h5md.hpp"
 
 namespace sheardiff {
 

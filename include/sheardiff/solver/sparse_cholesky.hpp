@@ -1,6 +1,4 @@
 #pragma once
-#include <cholmod.h>
-
 #include <Eigen/SparseCore>
 #include <memory>
 #include <string>
@@ -21,9 +19,6 @@ class SparseCholesky {
   // the analysis' flop counts (0: unknown).
   virtual double solves_per_factorisation() const { return 0.0; }
 };
-
-// The ordering and supernode settings sheardiff uses for CHOLMOD (measured, see the .cpp).
-void tune_cholmod(cholmod_common& c);
 
 // "cholmod": CHOLMOD supernodal LLT (SuiteSparse; fastest, see docs/performance.md);
 // "eigen": Eigen's SimplicialLLT.
