@@ -6,9 +6,13 @@ and, where RUN/analysis.h5 exists, the diffusion analysis.
 
 timeseries.png: the friction coefficient mu, the area fraction phi, the gap H and the pressure
 on the top wall (pressure cell; a simple-shear run has the particle pressure and no H) against
-strain, with the steady window shaded (pressure cell: from summary.json's steady_strain, the
-measurement starting at steady_detected_at; simple shear: after run.transient_strain) and the
-window's mean +- standard error in each panel.
+strain, a running mean over about one strain, the measured window shaded (pressure cell: from
+summary.json's steady_detected_at, where the run's measurement starts; simple shear: after
+run.transient_strain) and the window's mean +- error in each panel. These are the run's own
+numbers: a finished pressure-cell run's means and error bars are summary.json's (phi, phi_err,
+mu, mu_err, H, H_err, pressure_measured); otherwise the means are of the frames in the window
+and the errors batch means over time blocks of analysis.error_block strain (at least 4 blocks),
+as the run computes them, never the spread of correlated frames. --print writes them as text.
 analysis.png (only with analysis.h5): the MSD in the gradient direction with the fit window and
 the line 2 D t + c, and the velocity autocorrelation C(tau)/C(0) with the persistence time Psi.
 """
@@ -51,7 +55,45 @@ def panels(series, pressure_cell, phi_fixed):
     return out
 
 
-def plot_timeseries(run, out):
+def batch_means_error(t, x, t_from, t_to, block):
+    """The run's error bar of a window's mean (src/analysis/uncertainty.cpp): blocks of `block`
+    strain, at least 4, each frame in the block of its time; the standard error of the block means."""
+    blocks = max(4, int((t_to - t_from) / block))
+    width = (t_to - t_from) / blocks
+    sel = (t >= t_from) & (t <= t_to) & np.isfinite(x)
+    if not (t_to > t_from) or sel.sum() < 8:
+        return float("nan")
+    idx = np.minimum(blocks - 1, ((t[sel] - t_from) / width).astype(int))
+    means = [x[sel][idx == b].mean() for b in range(blocks) if np.any(idx == b)]
+    if len(means) < 2:
+        return float("nan")
+    return float(np.std(means, ddof=1) / np.sqrt(len(means)))
+
+
+# A finished pressure-cell run's own numbers for each panel: (summary key, its error key).
+SUMMARY_KEYS = {r"$\mu$": ("mu", "mu_err"), r"$\phi$": ("phi", "phi_err"), r"$H / d$": ("H", "H_err"),
+                r"wall pressure / $P$": ("pressure_measured", None)}
+
+
+def window_numbers(strain, rows, window, summary, block, pressure_cell):
+    """Each panel's (mean, error, source) over the measured window."""
+    out = {}
+    for label, y in rows:
+        if label.endswith("(fixed)"):
+            continue  # a set value, not a measurement
+        keys = SUMMARY_KEYS.get(label) if pressure_cell and summary.get("steady") else None
+        if keys and keys[0] in summary:
+            err = summary.get(keys[1]) if keys[1] else None
+            out[label] = (summary[keys[0]], float("nan") if err is None else err, "summary.json")
+            continue
+        sel = (strain >= window[0]) & (strain <= window[1]) & np.isfinite(y)
+        if sel.sum() >= 2:
+            out[label] = (float(np.mean(y[sel])), batch_means_error(strain, y, window[0], window[1], block),
+                          "frames, time blocks")
+    return out
+
+
+def plot_timeseries(run, out, print_numbers=False):
     traj = run / "trajectory.h5"
     cfg = tomllib.loads((run / "config.toml").read_text()) if (run / "config.toml").is_file() else {}
     summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").is_file() else {}
@@ -60,28 +102,30 @@ def plot_timeseries(run, out):
         sys.exit(f"plot_run: {traj} holds no frames yet")
     strain = series["strain"]
     pressure_cell = "mu_top" in series
-    window, detected = None, None
+    window = None
     if pressure_cell and summary.get("steady"):
-        window, detected = (summary["steady_strain"], strain[-1]), summary.get("steady_detected_at")
+        window = (summary["steady_detected_at"], strain[-1])
     elif not pressure_cell:
         window = (cfg.get("run", {}).get("transient_strain", 0.0), strain[-1])
+    block = cfg.get("analysis", {}).get("error_block", 3.0)
     rows = panels(series, pressure_cell, summary.get("phi"))
+    numbers = window_numbers(strain, rows, window, summary, block, pressure_cell) if window else {}
     fig, axes = plt.subplots(len(rows), 1, figsize=(7, 2.1 * len(rows)), sharex=True)
     # A running mean over about one strain shows the drift through the fluctuations.
     width = max(1, int(round(1.0 / max(np.median(np.diff(strain)), 1e-12)))) if len(strain) > 1 else 1
     for ax, (label, y) in zip(np.atleast_1d(axes), rows):
-        ax.plot(strain, y, "-", color="0.55", lw=0.8)
+        ax.plot(strain, y, "-", color="0.55", lw=0.8, label="frames")
         if width > 1 and len(y) > width:
-            ax.plot(strain, ndimage.uniform_filter1d(y, width, mode="nearest"), "-", color="C0", lw=1.5)
+            ax.plot(strain, ndimage.uniform_filter1d(y, width, mode="nearest"), "-", color="C0", lw=1.5,
+                    label="running mean (1 strain)")
         if window is not None:
             ax.axvspan(*window, color="C2", alpha=0.12, lw=0)
-            sel = (strain >= window[0]) & np.isfinite(y)
-            if sel.sum() >= 2:
-                m, e = np.mean(y[sel]), stats.sem(y[sel])
-                ax.axhline(m, color="C2", lw=1, ls="--", label=f"steady: {m:.4g} $\\pm$ {e:.2g}")
-                ax.legend(loc="best", fontsize=8, frameon=False)
-        if detected is not None:
-            ax.axvline(detected, color="C2", lw=0.8, ls=":")
+        if label in numbers:
+            m, e, source = numbers[label]
+            err = f" $\\pm$ {e:.2g}" if np.isfinite(e) else ""
+            ax.axhline(m, color="C2", lw=1, ls="--", label=f"measured: {m:.4g}{err} ({source})")
+        if not label.endswith("(fixed)"):
+            ax.legend(loc="best", fontsize=7, frameon=False)
         ax.set_ylabel(label)
         ax.ticklabel_format(axis="y", useOffset=False)
         finite = y[np.isfinite(y)]
@@ -97,6 +141,10 @@ def plot_timeseries(run, out):
     fig.savefig(out, dpi=110)
     plt.close(fig)
     print(out)
+    if print_numbers:
+        for label, (m, e, source) in numbers.items():
+            name = label.replace("$", "").replace("\\", "")
+            print(f"{name}: {m:.10g} +- {e:.10g} ({source})")
 
 
 def plot_analysis(run, out):
@@ -138,11 +186,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("run", type=pathlib.Path)
     ap.add_argument("--out", type=pathlib.Path, help="time-series PNG (default RUN/timeseries.png)")
+    ap.add_argument("--print", action="store_true", help="also print each panel's mean +- error and its source")
     args = ap.parse_args()
     if not (args.run / "trajectory.h5").is_file():
         sys.exit(f"plot_run: no trajectory at {args.run / 'trajectory.h5'} (run with output.trajectory = true)")
     try:
-        plot_timeseries(args.run, args.out or args.run / "timeseries.png")
+        plot_timeseries(args.run, args.out or args.run / "timeseries.png", args.print)
         if (args.run / "analysis.h5").is_file() and (args.run / "summary.json").is_file():
             plot_analysis(args.run, args.run / "analysis.png")
     except (OSError, KeyError) as e:

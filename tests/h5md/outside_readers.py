@@ -55,13 +55,13 @@ phi_init = 0.6
 [flow]
 J = 1e-2
 [run]
-strain = 2.0
+strain = 3.0
 seed = 2
 [analysis]
 diffusion = false
 [steady]
 window = 0.3
-measure_strain = 0.3
+measure_strain = 0.6
 [output]
 frame_strain = 0.05
 contacts = true
@@ -238,6 +238,30 @@ def check_continuity(root, traj):
                              f"(largest move per frame {gstep:.3f} d)")
 
 
+def check_plot_run_numbers(root, run_dir):
+    """plot_run.py shows a finished pressure-cell run's own means and error bars (issue 34: it
+    recomputed them from a later window, with the spread of correlated frames as the error)."""
+    import json
+    summary = json.loads((run_dir / "summary.json").read_text())
+    if not summary.get("steady"):
+        expect(False, f"{run_dir.name}: the test run reaches steady state")
+        return
+    p = subprocess.run([sys.executable, str(root / "tools" / "plot_run.py"), str(run_dir), "--print",
+                        "--out", str(run_dir / "numbers.png")], capture_output=True, text=True)
+    shown = {}
+    for line in p.stdout.splitlines():
+        if ": " in line and " +- " in line:
+            name, rest = line.split(": ", 1)
+            shown[name] = [float(x) for x in rest.split(" (")[0].split(" +- ")]
+    for name, key in (("phi", "phi"), ("mu", "mu"), ("H / d", "H")):
+        got = shown.get(name)
+        want = [summary[key], summary.get(key + "_err", float("nan"))]
+        if not np.isfinite(want[1]):
+            expect(False, f"{run_dir.name}: the test run's window has error bars ({key}_err)")
+        same = got is not None and all(np.isclose(a, b, rtol=1e-9, equal_nan=True) for a, b in zip(got, want))
+        expect(same, f"plot_run.py shows {run_dir.name}'s own {key} and {key}_err ({got} against {want})")
+
+
 def check_plot_tools(root, work, runs):
     """The plot tools draw both runs (no analysis.h5 in either) and end with one line, not a
     traceback, when their input is missing."""
@@ -247,6 +271,8 @@ def check_plot_tools(root, work, runs):
                                capture_output=True, text=True)
             expect(p.returncode == 0 and (run_dir / png).is_file(),
                    f"{tool} draws {run_dir.name}/{png}" + (f": {p.stderr.strip()}" if p.returncode else ""))
+        if tool == "plot_run.py":
+            check_plot_run_numbers(root, runs[-1])
         p = subprocess.run([sys.executable, str(root / "tools" / tool), str(work / "missing")],
                            capture_output=True, text=True)
         lines = p.stderr.strip().splitlines()
