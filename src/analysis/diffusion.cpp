@@ -174,15 +174,23 @@ void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& 
   const hid_t f = H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   if (f < 0) fail("create");
   try {
-    write_vector(f, "/msd/lag", r.msd.lag);
-    write_vector(f, "/msd/msd", r.msd.msd);
-    write_vector(f, "/msd/samples",
-                 std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()));
-    write_vector(f, "/vacf/lag", r.vacf.lag);
-    write_vector(f, "/vacf/c", r.vacf.c);
+    // Units and descriptions as docs/outputs.md gives them.
+    write_vector(f, "/msd/lag", r.msd.lag, "1/gammadot", "lag tau of the MSD, in strain");
+    write_vector(f, "/msd/msd", r.msd.msd, "d^2",
+                 "mean square displacement in the gradient direction y over the mobile discs and "
+                 "the reference times");
+    write_vector(f, "/msd/samples", std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()),
+                 "1", "number of (disc, reference time) pairs averaged at each lag");
+    write_vector(f, "/vacf/lag", r.vacf.lag, "1/gammadot", "lag tau of the VACF, in strain");
+    write_vector(f, "/vacf/c", r.vacf.c, "(gammadot d)^2",
+                 "velocity autocorrelation <v_y(t0) v_y(t0 + tau)> of the mobile discs, not "
+                 "normalised: C(0) = dv^2");
     if (r.has_bulk) {
-      write_vector(f, "/msd/msd_bulk", r.msd_bulk.msd);
-      write_vector(f, "/vacf/c_bulk", r.vel_bulk.c.c);
+      write_vector(f, "/msd/msd_bulk", r.msd_bulk.msd, "d^2",
+                   "the MSD over discs in the bulk at the reference time (observables."
+                   "wall_exclusion inside both walls)");
+      write_vector(f, "/vacf/c_bulk", r.vel_bulk.c.c, "(gammadot d)^2",
+                   "the VACF over origins in the bulk");
     }
     H5Id root{H5Gopen2(f, "/", H5P_DEFAULT), H5Gclose};
     write_attribute(root.id, "D", r.fit.d);

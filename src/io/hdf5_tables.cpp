@@ -16,9 +16,26 @@ hid_t link_with_groups() {
   return lcpl;
 }
 
+void describe(hid_t ds, const std::string& unit, const std::string& description) {
+  if (!unit.empty()) write_text_attribute(ds, "unit", unit);
+  if (!description.empty()) write_text_attribute(ds, "description", description);
+}
+
 }  // namespace
 
-void write_vector(hid_t file, const std::string& name, const std::vector<double>& v) {
+void write_text_attribute(hid_t obj, const char* name, const std::string& text) {
+  H5Id type{H5Tcopy(H5T_C_S1), H5Tclose};
+  H5Tset_size(type.id, H5T_VARIABLE);
+  H5Tset_cset(type.id, H5T_CSET_ASCII);
+  H5Id space{H5Screate(H5S_SCALAR), H5Sclose};
+  H5Id a{H5Acreate2(obj, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  const char* p = text.c_str();
+  if (a.id < 0 || H5Awrite(a.id, type.id, &p) < 0)
+    throw std::runtime_error(std::string("cannot write attribute ") + name);
+}
+
+void write_vector(hid_t file, const std::string& name, const std::vector<double>& v,
+                  const std::string& unit, const std::string& description) {
   const hsize_t n = v.size();
   H5Id space{H5Screate_simple(1, &n, nullptr), H5Sclose};
   const H5Id lcpl{link_with_groups(), H5Pclose};
@@ -27,10 +44,12 @@ void write_vector(hid_t file, const std::string& name, const std::vector<double>
           H5Dclose};
   if (ds.id < 0 || H5Dwrite(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
     throw std::runtime_error("cannot write dataset " + name);
+  describe(ds.id, unit, description);
 }
 
 void write_compressed_table(hid_t file, const std::string& name,
-                            const std::vector<std::vector<double>>& rows, std::size_t cols) {
+                            const std::vector<std::vector<double>>& rows, std::size_t cols,
+                            const std::string& unit, const std::string& description) {
   const hsize_t dims[2] = {rows.size(), cols};
   std::vector<float> flat;
   flat.reserve(rows.size() * cols);
@@ -53,6 +72,7 @@ void write_compressed_table(hid_t file, const std::string& name,
   if (ds.id < 0 || (!flat.empty() && H5Dwrite(ds.id, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL,
                                               H5P_DEFAULT, flat.data()) < 0))
     throw std::runtime_error("cannot write dataset " + name);
+  describe(ds.id, unit, description);
 }
 
 void write_attribute(hid_t obj, const char* name, double x) {

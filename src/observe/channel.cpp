@@ -233,17 +233,26 @@ void write_channel_history(const ChannelHistory& h, const std::filesystem::path&
   {
     H5Id f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
     if (f.id < 0) throw std::runtime_error("cannot create " + tmp);
-    write_vector(f.id, "/channel_history/y", h.y);
-    write_vector(f.id, "/channel_history/time", h.time);
-    write_vector(f.id, "/channel_history/pressure_gradient_ratio", h.pressure_gradient_ratio);
-    write_vector(f.id, "/channel_history/centre_distance", h.centre_distance);
-    write_vector(f.id, "/channel_history/u_p_mean", h.u_p_mean);
+    // Units and descriptions as docs/outputs.md gives them.
+    write_vector(f.id, "/channel_history/y", h.y, "H", "bin centres across the channel, y/H");
+    write_vector(f.id, "/channel_history/time", h.time, "a/<u>", "end of each sample interval");
+    write_vector(f.id, "/channel_history/pressure_gradient_ratio", h.pressure_gradient_ratio, "1",
+                 "pressure gradient over Poiseuille's G0 = 12 eta <u> / H^2, interval mean");
+    write_vector(f.id, "/channel_history/centre_distance", h.centre_distance, "d",
+                 "mean distance of the mobile discs from the centreline, interval mean");
+    write_vector(f.id, "/channel_history/u_p_mean", h.u_p_mean, "<u>",
+                 "mean x velocity of the mobile discs, interval mean");
     // float32: one bin of one interval averages a few tens of disc samples, a statistical
     // error of several per cent, far above float32's 1e-7; as text the profiles made a long
     // run's summary megabytes.
+    // In the order of ChannelHistory::profile_names, as docs/outputs.md gives them.
+    const std::array<const char*, 5> profile_units = {"1", "<u>", "<u>", "<u>^2 (a/H)^2",
+                                                      "<u>^2 (a/H)^2"};
     for (int k = 0; k < 5; ++k)
       write_compressed_table(f.id, std::string("/channel_history/") + h.profile_names[k],
-                             h.profiles[k], h.y.size());
+                             h.profiles[k], h.y.size(), profile_units[k],
+                             "profile across the channel, one row per sample interval, one "
+                             "column per bin of y (NaN: no disc in the bin)");
   }
   std::filesystem::rename(tmp, file);
 }

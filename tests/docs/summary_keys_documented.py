@@ -4,7 +4,8 @@
 Runs a small simple-shear run and a small pressure-cell run (both with the diffusion analysis)
 and a short channel run, then reads the keys of their summary.json files; each must appear as
 the first cell of a table row of docs/outputs.md, in backticks. Fails naming the keys that are
-not, so that a new key cannot go undocumented.
+not, so that a new key cannot go undocumented. Every dataset of their analysis.h5 and channel.h5
+must carry "unit" and "description" attributes (issue 34: the files described nothing).
 
     summary_keys_documented.py --bin build/sheardiff --root . --work DIR
 """
@@ -106,7 +107,21 @@ def main():
     for scene in ("simple_shear", "pressure_cell", "channel"):
         if not summaries[scene]:
             sys.exit(f"{scene}: empty summary")
-    if missing:
+    import h5py
+
+    bare = []
+    for f in (args.work / "simple_shear" / "analysis.h5", args.work / "pressure_cell" / "analysis.h5",
+              args.work / "channel" / "channel.h5"):
+        with h5py.File(f, "r") as h:
+            def visit(name, obj):
+                if isinstance(obj, h5py.Dataset) and not ("unit" in obj.attrs and "description" in obj.attrs):
+                    bare.append(f"{f.parent.name}/{f.name}:{name}")
+            h.visititems(visit)
+    for b in bare:
+        print(f"FAIL  {b} has no unit or description attribute")
+    if not bare:
+        print("ok    every dataset of analysis.h5 and channel.h5 has a unit and a description")
+    if missing or bare:
         for key, name in missing:
             print(f"FAIL  `{key}` ({name}) is not documented in docs/outputs.md")
         sys.exit(1)

@@ -23,13 +23,19 @@ struct H5Id {
 };
 
 // A float64 vector at `name` (intermediate groups created).
-void write_vector(hid_t file, const std::string& name, const std::vector<double>& v);
+// With a unit and a description (attributes "unit" and "description", docs/outputs.md), so that
+// the file says what it holds.
+void write_vector(hid_t file, const std::string& name, const std::vector<double>& v,
+                  const std::string& unit = "", const std::string& description = "");
+// A scalar string attribute (ASCII, variable length).
+void write_text_attribute(hid_t obj, const char* name, const std::string& text);
 
 // rows x cols as float32, chunked and compressed (shuffle + deflate): for tables whose values
 // carry a few significant digits, where float64 text or binary would be mostly noise.
 // Every row must hold cols values.
 void write_compressed_table(hid_t file, const std::string& name,
-                            const std::vector<std::vector<double>>& rows, std::size_t cols);
+                            const std::vector<std::vector<double>>& rows, std::size_t cols,
+                            const std::string& unit = "", const std::string& description = "");
 
 void write_attribute(hid_t obj, const char* name, double x);
 
