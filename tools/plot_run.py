@@ -161,12 +161,20 @@ def plot_analysis(run, out):
     ok = lag > 0
     ax1.loglog(lag[ok], msd[ok], "-", label="MSD")
     t = np.linspace(lo, hi, 50)
-    ax1.loglog(t, 2 * d * t + intercept, "k--", label=f"fit: D = {d:.3g} $\\dot\\gamma d^2$")
+    d_err = summary.get("D_err")
+    err = f" $\\pm$ {d_err:.2g}" if isinstance(d_err, (int, float)) else ""
+    ax1.loglog(t, 2 * d * t + intercept, "k--", label=f"fit: D = {d:.3g}{err} $\\dot\\gamma d^2$")
     ax1.axvspan(lo, hi, color="0.9")
     ax1.set_xlabel(r"strain $\dot\gamma t$")
     ax1.set_ylabel(r"$\Delta_y^2 / d^2$")
     ax1.set_title(f"J = {summary['J']:g}, N = {summary['N']}, ktilde = {summary['ktilde']:g}")
-    ax1.legend()
+    # The run's own warning about the fit (summary.json): a D from a window that is not yet
+    # diffusive is not a diffusion coefficient.
+    warn = [w for w in summary.get("analysis_warnings", []) if "not diffusive" in w]
+    if warn:
+        ax1.text(0.02, 0.98, "warning: " + warn[0], transform=ax1.transAxes, va="top", fontsize=6,
+                 color="C3", wrap=True)
+    ax1.legend(loc="lower right")
     ax2.plot(tau, c / c[0], "-")
     ax2.axhline(0, color="0.6", lw=0.5)
     ax2.axhline(np.exp(-1), color="0.6", lw=0.5, ls=":")

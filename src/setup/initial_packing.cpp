@@ -44,6 +44,11 @@ Packing packing_from_file(const Config& cfg) {
   Packing pk;
   std::vector<double> diameter;
   const auto ext = file.extension().string();
+  if (ext == ".gsd")
+    throw ConfigError(fmt::format(
+        "particles.init_file: {}: a GSD file is not read; give an H5MD trajectory (.h5, .hdf5, "
+        ".h5md: a frame of a run) or a text table of x y diameter",
+        file.string()));
   if (ext == ".h5" || ext == ".hdf5" || ext == ".h5md") {
     H5mdFrame f = read_h5md_frame(file, cfg.particles.init_frame);
     for (std::size_t k = 0; k < f.position.size(); ++k) {

@@ -145,7 +145,12 @@ def check_gsd(root, traj, periodic_y):
         edges = g["box/edges/value"][()]
         diam = g["diameter"][()]
         pairs = f["connectivity/contacts/value"][()]
+        normal = f["connectivity/contacts/normal_force"][()]
         max_overlap = f["observables/max_overlap/value"][()]
+    listed = normal[pairs[:, :, 0] >= 0]
+    expect(listed.size > 0 and bool(np.all(listed > 0)),
+           f"{name}: every listed contact has a normal force > 0 ({listed.size} entries, smallest "
+           f"{listed.min(initial=np.inf):.3g}; a pair the last move opened used to be listed with 0)")
     try:
         traj_gsd = gsd.hoomd.open(name=str(out), mode="r")
     except ValueError:

@@ -123,6 +123,16 @@ TEST(InitialConfiguration, OverlappingDiscsInAFileAreRefused) {
   refused("1 1 1\n4 1 1.4\n1 4 1\n1 4 1\n", "particles 2 and 3");
   // x = 0.1 and 4.47 are 0.45 d apart through the periodic edge.
   refused("0.1 1 1\n2.5 1 1.4\n4.47 1 1\n2.5 3.5 1.4\n", "particles 0 and 2");
+  // A GSD file (the export's format) is named as such, not parsed as a table (issue 34).
+  c.particles.init_file = (dir / "start.gsd").string();
+  { std::ofstream(dir / "start.gsd") << "binary"; }
+  try {
+    validate_run_inputs(c, "test");
+    ADD_FAILURE() << "a GSD file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("a GSD file is not read"), std::string::npos) << e.what();
+  }
+  c.particles.init_file = (dir / "start.txt").string();
   // Touching with a 1 % overlap (a dense run's last frame) is a start.
   { std::ofstream(dir / "start.txt") << "1 1 1\n1.99 1 1\n1 3 1.4\n3 3 1.4\n"; }
   EXPECT_NO_THROW(validate_run_inputs(c, "test"));
