@@ -209,9 +209,14 @@ CommandLine::CommandLine() {
 
   analyse = app.add_subcommand(
       "analyse",
-      "Recompute the diffusion analysis (MSD, D, dv, VACF, Psi) of a finished run "
-      "from DIR/trajectory.h5 alone; rewrites DIR/analysis.h5 and summary.json");
+      "Recompute the analysis (MSD, D, dv, VACF, Psi; the pressure cell's error bars and "
+      "stationarity) of a finished run from DIR/trajectory.h5 alone. Adds what the run lacked to "
+      "DIR/summary.json and never changes a number it wrote: a result that differs, or one with "
+      "--set, goes to DIR/reanalysis/");
   analyse->add_option("dir", run_dir, "Run directory")->required();
+  analyse->add_option("--set", overrides,
+                      "Analyse the same frames with another setting, analysis.KEY=value or "
+                      "observables.KEY=value (repeatable), e.g. --set analysis.msd_window_lo=4");
 
   sweep = app.add_subcommand(
       "sweep",
@@ -275,7 +280,7 @@ int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory
   dir->start_log(sheardiff::this_command_line());
   dir->remove_partial_files();  // of an earlier analyse killed while writing
   sheardiff::Reanalysis re;
-  dir->with_hdf5_reasons([&] { re = sheardiff::reanalyse_run(run_dir); });
+  dir->with_hdf5_reasons([&] { re = sheardiff::reanalyse_run(run_dir, cl.overrides); });
   const auto h5 = re.folder / "analysis.h5";
   if (std::filesystem::exists(h5) && !sheardiff::hdf5_file_opens(h5))
     throw sheardiff::IoError(fmt::format("cannot write {}: {}", h5.string(),
@@ -284,7 +289,13 @@ int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory
                                              : dir->hdf5_log()->last_os_reason()));
   const nlohmann::json& js = re.summary;
   fmt::print("{}", sheardiff::analysis_result_text(js, run_dir));
-  if (!re.differs.empty())
+  if (!cl.overrides.empty())
+    fmt::print("the analysis with {}{}: written to {}; the run's files are as they were\n",
+               fmt::join(cl.overrides, ", "),
+               re.differs.empty() ? std::string()
+                                  : fmt::format(" (changes {})", fmt::join(re.differs, ", ")),
+               re.folder.string());
+  else if (!re.differs.empty())
     fmt::print(
         "the analysis differs from the run's own in {}: written to {} (summary.json, "
         "analysis.h5); the run's files are as they were\n",

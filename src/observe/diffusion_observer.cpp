@@ -100,9 +100,16 @@ nlohmann::json merge_analysis(const nlohmann::json& run, const nlohmann::json& c
 
 }  // namespace
 
-Reanalysis reanalyse_run(const std::filesystem::path& dir) {
+Reanalysis reanalyse_run(const std::filesystem::path& dir,
+                         const std::vector<std::string>& overrides) {
   const auto traj = dir / "trajectory.h5";
-  const Config cfg = load_config(dir / "config.toml");
+  for (const std::string& o : overrides)
+    if (!o.starts_with("analysis.") && !o.starts_with("observables."))
+      throw ConfigError(fmt::format(
+          "analyse --set {}: only analysis.* and observables.* keys change an analysis of the "
+          "same frames; the others change the run (run it again)",
+          o));
+  const Config cfg = load_config(dir / "config.toml", overrides);
   nlohmann::json run;
   {
     std::ifstream in(dir / "summary.json");
@@ -220,14 +227,16 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir) {
   out.summary = merge_analysis(run, computed, out.differs);
   // Nothing the run wrote is replaced: where the analysis disagrees with it (an older version's
   // numbers), the whole analysis goes beside the run's files.
-  out.folder = out.differs.empty() ? dir : dir / "reanalysis";
+  if (!overrides.empty()) out.summary["analysed_with"] = overrides;
+  out.folder = out.differs.empty() && overrides.empty() ? dir : dir / "reanalysis";
   const bool summary_changes = out.summary != run;
   // The run's own version stays; the analysis says which code recomputed it.
   if (summary_changes) out.summary["analysed_by"] = version_line();
-  if (!out.differs.empty()) std::filesystem::create_directories(out.folder);
-  if (r && (!out.differs.empty() || !std::filesystem::exists(dir / "analysis.h5")))
+  const bool beside = out.folder != dir;
+  if (beside) std::filesystem::create_directories(out.folder);
+  if (r && (beside || !std::filesystem::exists(dir / "analysis.h5")))
     write_analysis_file(*r, out.folder / "analysis.h5");
-  if (summary_changes)
+  if (summary_changes || beside)
     write_file_atomically(out.folder / "summary.json", json_text(out.summary) + "\n");
   return out;
 }

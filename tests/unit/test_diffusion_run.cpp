@@ -14,6 +14,8 @@
 namespace sheardiff {
 namespace {
 
+std::string file_text(const std::filesystem::path& f);
+
 TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   Config c;
   c.particles.n = 60;
@@ -47,6 +49,19 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   // Frames are written at the first step past each multiple of 0.01, so the one at 0.3 lies just
   // past the transient: 0.30, 0.31, ..., 1.50.
   EXPECT_EQ(during["analysis_frames"].get<long>(), 121);
+
+  // Another analysis setting (issue 34: analyse took no --set) analyses the same frames into
+  // DIR/reanalysis/, saying so, and leaves the run's summary as it was; a key that changes the
+  // run itself is refused.
+  const std::string before = file_text(dir / "summary.json");
+  const Reanalysis other = reanalyse_run(dir, {"analysis.msd_window_lo=0.25"});
+  EXPECT_EQ(other.folder, dir / "reanalysis");
+  EXPECT_EQ(file_text(dir / "summary.json"), before);
+  const auto written = nlohmann::json::parse(file_text(dir / "reanalysis" / "summary.json"));
+  EXPECT_EQ(written["msd_window"][0].get<double>(), 0.25);
+  EXPECT_EQ(written["analysed_with"][0], "analysis.msd_window_lo=0.25");
+  EXPECT_TRUE(std::filesystem::exists(dir / "reanalysis" / "analysis.h5"));
+  EXPECT_THROW(reanalyse_run(dir, {"flow.J=0.2"}), ConfigError);
   std::filesystem::remove_all(dir);
 }
 

@@ -50,7 +50,10 @@ struct Reanalysis {
 };
 
 // Recomputes the analysis of a finished run from DIR/trajectory.h5, DIR/config.toml and
-// DIR/summary.json alone.
-Reanalysis reanalyse_run(const std::filesystem::path& dir);
+// DIR/summary.json alone. `overrides` (analysis.KEY=value, observables.KEY=value) analyse the
+// same frames with other settings: that result always goes to DIR/reanalysis/, with the
+// overrides in its summary (`analysed_with`). Another key is refused (ConfigError).
+Reanalysis reanalyse_run(const std::filesystem::path& dir,
+                         const std::vector<std::string>& overrides = {});
 
 }  // namespace sheardiff
