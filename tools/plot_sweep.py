@@ -103,7 +103,9 @@ def main():
               title="(a) MSD, gradient direction (fig. 1c)")
     ax[1].set(xlabel=r"$t / \Psi$", ylabel=r"$\langle\Delta y^2\rangle / d^2$",
               title="(b) MSD against t / Psi (fig. 1c inset)")
-    inset = ax[3].inset_axes([0.58, 0.55, 0.38, 0.38])
+    # Lower left: phi falls with J, so that corner stays clear of the points (upper right hid
+    # J = 1e-2); the legend goes to the upper right.
+    inset = ax[3].inset_axes([0.24, 0.17, 0.34, 0.34])
 
     def errbar(a, x, y, e, e_open, c, m, label):
         """Seed-scatter error bars filled; run-own error bars (one seed) open."""
@@ -219,7 +221,7 @@ def main():
     ax[11].axis("off")
     for a_ in ax[2:10]:
         if a_.get_legend_handles_labels()[0]:
-            a_.legend(fontsize=7, loc="lower left" if a_ is ax[3] else "best")
+            a_.legend(fontsize=7, loc="upper right" if a_ is ax[3] else "best")
     fig.suptitle(f"{args.sweep}: {fits['finished']}/{fits['points']} points; error bars: standard "
                  "error over seeds (open: one run's own error)")
     fig.tight_layout()
