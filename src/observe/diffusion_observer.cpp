@@ -100,6 +100,124 @@ nlohmann::json merge_analysis(const nlohmann::json& run, const nlohmann::json& c
 
 }  // namespace
 
+namespace {
+
+// The run's finished summary.
+nlohmann::json read_summary(const std::filesystem::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  if (!in)
+    throw std::runtime_error(fmt::format("{}: no summary.json (run not finished?)", dir.string()));
+  return nlohmann::json::parse(in);
+}
+
+// The measured window's frames of a trajectory, as the observers saw them while running: the
+// mobile discs' unwrapped y and v_y / gammadot, the walls' centre lines and, if asked, the gap
+// profiles.
+struct WindowFrames {
+  Eigen::MatrixXd y, vy;
+  Eigen::VectorXd bottom, top;
+  bool walls = false;
+  GapProfiles profiles;
+  double height_sum = 0;
+  explicit WindowFrames(double bin) : profiles(bin) {}
+};
+
+WindowFrames read_window(const std::filesystem::path& traj, const std::vector<long>& frames,
+                         const Config& cfg, bool want_profiles) {
+  WindowFrames w(cfg.observables.profile_bin);
+  w.bottom.resize(static_cast<Eigen::Index>(frames.size()));
+  w.top.resize(w.bottom.size());
+  for (std::size_t row = 0; row < frames.size(); ++row) {
+    const auto r = static_cast<Eigen::Index>(row);
+    const H5mdFrame f = read_h5md_frame(traj, frames[row]);
+    if (f.unwrapped.empty() || f.velocity.empty())
+      throw std::runtime_error(
+          fmt::format("{}: frames lack unwrapped positions or velocities "
+                      "(output.velocities = false?)",
+                      traj.string()));
+    std::vector<std::size_t> mobile;
+    for (std::size_t i = 0; i < f.position.size(); ++i)
+      if (f.motion.empty() || f.motion[i] == 0) mobile.push_back(i);
+    if (row == 0) {
+      w.y.resize(static_cast<Eigen::Index>(frames.size()),
+                 static_cast<Eigen::Index>(mobile.size()));
+      w.vy.resizeLike(w.y);
+    }
+    for (std::size_t c = 0; c < mobile.size(); ++c) {
+      w.y(r, static_cast<Eigen::Index>(c)) = f.unwrapped[mobile[c]].y();
+      w.vy(r, static_cast<Eigen::Index>(c)) = f.velocity[mobile[c]].y() / cfg.flow.j;
+    }
+    // Wall centre lines (fixed bottom, floating top) for the bulk-only analysis and profiles.
+    double yb = 0, yt = 0;
+    long nb = 0, nt = 0;
+    for (std::size_t i = 0; i < f.motion.size(); ++i) {
+      if (f.motion[i] == static_cast<int>(Motion::FixedWall)) yb += f.position[i].y(), ++nb;
+      if (f.motion[i] == static_cast<int>(Motion::FloatingWall) ||
+          f.motion[i] == static_cast<int>(Motion::DrivenWall))
+        yt += f.position[i].y(), ++nt;
+    }
+    if (nb == 0 || nt == 0) continue;
+    w.walls = true;
+    w.bottom(r) = yb / static_cast<double>(nb);
+    w.top(r) = yt / static_cast<double>(nt);
+    if (!want_profiles) continue;
+    Particles p;
+    p.n_mobile = mobile.size();
+    std::vector<Vec3> u;
+    for (std::size_t c = 0; c < mobile.size(); ++c) {
+      p.position.push_back(f.position[mobile[c]]);
+      p.radius.push_back(0.5 * f.diameter[mobile[c]]);
+      u.push_back(f.velocity[mobile[c]]);
+    }
+    const double h = w.top(r) - w.bottom(r);
+    w.height_sum += h;
+    w.profiles.add(p, u, w.bottom(r), h, f.lx, 1.0);
+  }
+  return w;
+}
+
+// The pressure cell's window keys from the frames' observables: the error bars and the
+// stationarity signals over the samples the run's observer took (every frame from the
+// detection of steady state on).
+void add_window_keys(const std::filesystem::path& traj, const Config& cfg,
+                     const std::vector<double>& strain, double from, double last,
+                     nlohmann::json& computed) {
+  const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
+  const auto h = series("H"), mu_top = series("mu_top"), mu_bottom = series("mu_bottom");
+  add_steady_errors(computed, strain, h, series("phi"), mu_top, mu_bottom, from, last,
+                    cfg.analysis.error_block);
+  if (has_h5md_observable(traj, "net_drag_y"))
+    add_stationarity(
+        computed, pressure_cell_stationarity(cfg.steady, strain, h, mu_top, mu_bottom,
+                                             series("net_drag_y"), series("bulk_normal_load"), from,
+                                             last, cfg.analysis.error_block));
+}
+
+// Writes what analyse found: nothing of the run's is replaced. Where the analysis disagrees
+// with it (an older version's numbers) or was asked for other settings, the whole analysis
+// goes beside the run's files.
+Reanalysis write_reanalysis(const std::filesystem::path& dir, const nlohmann::json& run,
+                            const nlohmann::json& computed,
+                            const std::optional<DiffusionReport>& report,
+                            const std::vector<std::string>& overrides) {
+  Reanalysis out;
+  out.summary = merge_analysis(run, computed, out.differs);
+  if (!overrides.empty()) out.summary["analysed_with"] = overrides;
+  out.folder = out.differs.empty() && overrides.empty() ? dir : dir / "reanalysis";
+  const bool summary_changes = out.summary != run;
+  // The run's own version stays; the analysis says which code recomputed it.
+  if (summary_changes) out.summary["analysed_by"] = version_line();
+  const bool beside = out.folder != dir;
+  if (beside) std::filesystem::create_directories(out.folder);
+  if (report && (beside || !std::filesystem::exists(dir / "analysis.h5")))
+    write_analysis_file(*report, out.folder / "analysis.h5");
+  if (summary_changes || beside)
+    write_file_atomically(out.folder / "summary.json", json_text(out.summary) + "\n");
+  return out;
+}
+
+}  // namespace
+
 Reanalysis reanalyse_run(const std::filesystem::path& dir,
                          const std::vector<std::string>& overrides) {
   const auto traj = dir / "trajectory.h5";
@@ -110,14 +228,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
           "same frames; the others change the run (run it again)",
           o));
   const Config cfg = load_config(dir / "config.toml", overrides);
-  nlohmann::json run;
-  {
-    std::ifstream in(dir / "summary.json");
-    if (!in)
-      throw std::runtime_error(
-          fmt::format("{}: no summary.json (run not finished?)", dir.string()));
-    run = nlohmann::json::parse(in);
-  }
+  const nlohmann::json run = read_summary(dir);
   if (scene_kind(cfg.scene.type).channel_flow)
     throw ConfigError(fmt::format(
         "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
@@ -140,105 +251,29 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
   // The run measured its profiles at every step; frames can only approximate them, so they are
   // computed here only for a run that has none (an older version's).
   const bool want_profiles = pressure && !run.contains("profile_phi");
-  Eigen::MatrixXd y, vy;
-  Eigen::VectorXd bottom(static_cast<Eigen::Index>(frames.size())), top(bottom.size());
-  bool walls = false;
-  GapProfiles profiles(cfg.observables.profile_bin);
-  double height_sum = 0;
-  for (std::size_t row = 0; row < frames.size(); ++row) {
-    const H5mdFrame f = read_h5md_frame(traj, frames[row]);
-    if (f.unwrapped.empty() || f.velocity.empty())
-      throw std::runtime_error(
-          fmt::format("{}: frames lack unwrapped positions or velocities "
-                      "(output.velocities = false?)",
-                      traj.string()));
-    std::vector<std::size_t> mobile;
-    for (std::size_t i = 0; i < f.position.size(); ++i)
-      if (f.motion.empty() || f.motion[i] == 0) mobile.push_back(i);
-    if (row == 0) {
-      y.resize(static_cast<Eigen::Index>(frames.size()), static_cast<Eigen::Index>(mobile.size()));
-      vy.resizeLike(y);
-    }
-    for (std::size_t c = 0; c < mobile.size(); ++c) {
-      y(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(c)) = f.unwrapped[mobile[c]].y();
-      vy(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(c)) =
-          f.velocity[mobile[c]].y() / cfg.flow.j;
-    }
-    // Wall centre lines (fixed bottom, floating top) for the bulk-only analysis and profiles.
-    double yb = 0, yt = 0;
-    long nb = 0, nt = 0;
-    for (std::size_t i = 0; i < f.motion.size(); ++i) {
-      if (f.motion[i] == static_cast<int>(Motion::FixedWall)) yb += f.position[i].y(), ++nb;
-      if (f.motion[i] == static_cast<int>(Motion::FloatingWall) ||
-          f.motion[i] == static_cast<int>(Motion::DrivenWall))
-        yt += f.position[i].y(), ++nt;
-    }
-    if (nb > 0 && nt > 0) {
-      walls = true;
-      const auto r = static_cast<Eigen::Index>(row);
-      bottom(r) = yb / static_cast<double>(nb);
-      top(r) = yt / static_cast<double>(nt);
-      if (!want_profiles) continue;
-      Particles p;
-      p.n_mobile = mobile.size();
-      std::vector<Vec3> u;
-      for (std::size_t c = 0; c < mobile.size(); ++c) {
-        p.position.push_back(f.position[mobile[c]]);
-        p.radius.push_back(0.5 * f.diameter[mobile[c]]);
-        u.push_back(f.velocity[mobile[c]]);
-      }
-      const double h = top(r) - bottom(r);
-      height_sum += h;
-      profiles.add(p, u, bottom(r), h, f.lx, 1.0);
-    }
-  }
+  WindowFrames w = read_window(traj, frames, cfg, want_profiles);
   Eigen::MatrixXd mask;
-  if (walls) mask = bulk_mask(y, bottom, top, cfg.observables.wall_exclusion);
+  if (w.walls) mask = bulk_mask(w.y, w.bottom, w.top, cfg.observables.wall_exclusion);
   nlohmann::json computed;
-  std::optional<DiffusionReport> r;
+  std::optional<DiffusionReport> report;
   try {
-    r = analyse_diffusion(y, vy, cfg.output.frame_strain, diffusion_settings(cfg),
-                          walls ? &mask : nullptr);
-    add_to_summary(*r, computed);
+    report = analyse_diffusion(w.y, w.vy, cfg.output.frame_strain, diffusion_settings(cfg),
+                               w.walls ? &mask : nullptr);
+    add_to_summary(*report, computed);
   } catch (const std::invalid_argument& e) {
     // As in the run: too little data for the fits is a finding, the rest is still computed.
     computed["analysis_warnings"] = {fmt::format("no diffusion analysis: {}", e.what())};
   }
   if (pressure) {
-    // The steady window's error bars and stationarity from the frames: the samples the run's
-    // observer took (every frame from the detection of steady state on).
-    const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
-    const auto h = series("H"), mu_top = series("mu_top"), mu_bottom = series("mu_bottom");
-    const double last = strain.value[static_cast<std::size_t>(frames.back())];
-    add_steady_errors(computed, strain.value, h, series("phi"), mu_top, mu_bottom, from, last,
-                      cfg.analysis.error_block);
-    if (has_h5md_observable(traj, "net_drag_y"))
-      add_stationarity(computed,
-                       pressure_cell_stationarity(cfg.steady, strain.value, h, mu_top, mu_bottom,
-                                                  series("net_drag_y"), series("bulk_normal_load"),
-                                                  from, last, cfg.analysis.error_block));
-    if (want_profiles && walls) {
-      profiles.to_summary(computed, cfg.flow.j, height_sum / static_cast<double>(frames.size()),
-                          cfg.observables.wall_exclusion);
+    add_window_keys(traj, cfg, strain.value, from,
+                    strain.value[static_cast<std::size_t>(frames.back())], computed);
+    if (want_profiles && w.walls) {
+      w.profiles.to_summary(computed, cfg.flow.j, w.height_sum / static_cast<double>(frames.size()),
+                            cfg.observables.wall_exclusion);
       computed["profiles_from"] = "frames";
     }
   }
-  Reanalysis out;
-  out.summary = merge_analysis(run, computed, out.differs);
-  // Nothing the run wrote is replaced: where the analysis disagrees with it (an older version's
-  // numbers), the whole analysis goes beside the run's files.
-  if (!overrides.empty()) out.summary["analysed_with"] = overrides;
-  out.folder = out.differs.empty() && overrides.empty() ? dir : dir / "reanalysis";
-  const bool summary_changes = out.summary != run;
-  // The run's own version stays; the analysis says which code recomputed it.
-  if (summary_changes) out.summary["analysed_by"] = version_line();
-  const bool beside = out.folder != dir;
-  if (beside) std::filesystem::create_directories(out.folder);
-  if (r && (beside || !std::filesystem::exists(dir / "analysis.h5")))
-    write_analysis_file(*r, out.folder / "analysis.h5");
-  if (summary_changes || beside)
-    write_file_atomically(out.folder / "summary.json", json_text(out.summary) + "\n");
-  return out;
+  return write_reanalysis(dir, run, computed, report, overrides);
 }
 
 }  // namespace sheardiff
