@@ -358,8 +358,9 @@ nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seco
                           RunDirectory& dir, TrajectoryOutput& trajectory) {
   nlohmann::json js = run_summary(cfg, run, wall_seconds, dir, trajectory);
   trajectory.close();
-  // analysis.h5 is written by code that does not check its file's close: a full disk there
-  // leaves a truncated file under the final name, which HDF5 then refuses to open.
+  // channel.h5's writer does not check its file's close (analysis.h5's does since it throws on
+  // a failed flush or close): a full disk there would leave a truncated file under the final
+  // name, which HDF5 then refuses to open.
   for (const char* name : {"analysis.h5", "channel.h5"}) {
     const auto file = dir.file(name);
     if (std::filesystem::exists(file) && !hdf5_file_opens(file)) {

@@ -281,12 +281,6 @@ int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory
   dir->remove_partial_files();  // of an earlier analyse killed while writing
   sheardiff::Reanalysis re;
   dir->with_hdf5_reasons([&] { re = sheardiff::reanalyse_run(run_dir, cl.overrides); });
-  const auto h5 = re.folder / "analysis.h5";
-  if (std::filesystem::exists(h5) && !sheardiff::hdf5_file_opens(h5))
-    throw sheardiff::IoError(fmt::format("cannot write {}: {}", h5.string(),
-                                         dir->hdf5_log()->last_os_reason().empty()
-                                             ? "the file was left incomplete"
-                                             : dir->hdf5_log()->last_os_reason()));
   const nlohmann::json& js = re.summary;
   fmt::print("{}", sheardiff::analysis_result_text(js, run_dir));
   if (!cl.overrides.empty())

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
@@ -71,10 +72,13 @@ fs::path point_lock(const fs::path& out_dir, const SweepPoint& p) {
 void run_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir,
                const std::function<void(const RunDirectory&, const nlohmann::json&)>& report) {
   fs::create_directories(out_dir / "logs");
-  if (locked_elsewhere(point_lock(out_dir, p)))
-    throw PointBusy(fmt::format("sweep point {} is being run by another process (lock {})", p.name,
-                                point_lock(out_dir, p).string()));
-  const FileLock lock(point_lock(out_dir, p), "sweep point " + p.name);
+  // Held by another process: that process runs the point, which is not a failure of it.
+  std::optional<FileLock> lock;
+  try {
+    lock.emplace(point_lock(out_dir, p), "sweep point " + p.name);
+  } catch (const ConfigError& e) {
+    throw PointBusy(e.what());
+  }
   const auto state = point_state(spec, p, out_dir);
   if (state == PointState::finished) return;
   const Config cfg = load_config(spec.base, p.overrides);
