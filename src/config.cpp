@@ -327,7 +327,19 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("analysis.msd_window_hi", &C::analysis, &C::Analysis::msd_window_hi, 0.0, 1e5,
                      true, "1 (strain)", "End of the MSD fit window (seed: 15)."));
     s.push_back(integer("analysis.reference_times", &C::analysis, &C::Analysis::reference_times, 1,
-                        1e8, "", "Reference times t0 of the MSD, drawn in the measured window."));
+                        1e8, "",
+                        "Unused (kept so that older configs load): every sample of the measured "
+                        "window is a reference time t0 of the MSD."));
+    s.push_back(real("analysis.sample_strain", &C::analysis, &C::Analysis::sample_strain, 0.0, 1.0,
+                     false, "1 (strain)",
+                     "Strain between two samples of the diffusion analysis, taken during the run "
+                     "(independent of the trajectory); 0 = output.frame_strain / 10, i.e. ~100 "
+                     "samples per persistence time."));
+    s.push_back(real("analysis.coarse_strain", &C::analysis, &C::Analysis::coarse_strain, 0.0, 1e3,
+                     false, "1 (strain)",
+                     "Strain between the samples D and its error bar are fitted to (every one "
+                     "an origin of the MSD), rounded to a whole number of samples; 0 = "
+                     "min(0.2, analysis.msd_window_hi / 75), i.e. 36 lags in the seed's window."));
     s.push_back(real("analysis.vacf_max_lag", &C::analysis, &C::Analysis::vacf_max_lag, 0.0, 1e3,
                      true, "1 (strain)", "Longest lag of the velocity autocorrelation."));
     s.push_back(real("analysis.error_block", &C::analysis, &C::Analysis::error_block, 0.0, 1e5,
@@ -586,6 +598,9 @@ void resolve_defaults(Config& c) {
     c.output.frame_strain = scene_kind(c.scene.type).channel_flow
                                 ? std::min(c.channel.sample_interval, c.run.strain)
                                 : 0.035 * std::pow(c.flow.j, 0.25);
+  if (c.analysis.sample_strain <= 0.0) c.analysis.sample_strain = 0.1 * c.output.frame_strain;
+  if (c.analysis.coarse_strain <= 0.0)
+    c.analysis.coarse_strain = std::min(0.2, c.analysis.msd_window_hi / 75.0);
 }
 
 Config parse_config(const std::string& toml_text, const std::string& origin,

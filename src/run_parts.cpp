@@ -8,6 +8,7 @@
 
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/stress.hpp"
 #include "sheardiff/scene/registry.hpp"
@@ -174,6 +175,17 @@ void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
             "state this version stores differently. It was neither resumed nor changed: finish "
             "the run with the sheardiff that started it (its version and git hash are at the top "
             "of {}/run.log), or start it again with --overwrite",
+            file_.string(), payload.layout, out_));
+  // Layout 6 accumulates the diffusion analysis instead of keeping the window's frames.
+  if (payload.layout < 6)
+    for (const auto& o : run.observers)
+      if (dynamic_cast<const DiffusionObserver*>(o.get()) != nullptr)
+        throw CorruptCheckpoint(fmt::format(
+            "{} was written by an earlier sheardiff (checkpoint layout {}), which kept the "
+            "measured window's frames for the diffusion analysis; this version accumulates it "
+            "while running. It was neither resumed nor changed: finish the run with the "
+            "sheardiff that started it (its version and git hash are at the top of "
+            "{}/run.log), or start it again with --overwrite",
             file_.string(), payload.layout, out_));
   Archive a = Archive::reader(std::move(payload.bytes));
   try {

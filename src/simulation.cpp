@@ -221,19 +221,6 @@ std::string refusal(const RunDirectory& dir) {
 
 }  // namespace
 
-double next_output_strain(double next, double spacing, double strain) {
-  const double until = strain * (1.0 + 1e-12);
-  // A spacing far below one step (a Config made in code is not range checked): skip ahead
-  // instead of adding it billions of times.
-  if (next <= until && (until - next) / spacing > 1e6)
-    next += std::floor((until - next) / spacing) * spacing;
-  while (next <= until) {
-    const double after = next + spacing;
-    if (!(after > next)) return std::nextafter(until, std::numeric_limits<double>::infinity());
-    next = after;
-  }
-  return next;
-}
 
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume) {

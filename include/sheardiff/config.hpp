@@ -105,9 +105,11 @@ struct Config {
     bool diffusion = true;        // MSD, VACF, dv, Psi, D over the measured window
     double msd_window_lo = 8.0;   // strain
     double msd_window_hi = 15.0;  // strain
-    std::int64_t reference_times = 1000;
+    std::int64_t reference_times = 1000;  // unused: every sample is an origin
     double vacf_max_lag = 2.0;  // strain
     double error_block = 3.0;   // strain: time blocks of the error bars
+    double sample_strain = 0.0;  // strain between samples; 0 = output.frame_strain / 10
+    double coarse_strain = 0.0;  // strain between the samples D comes from; 0 = auto
   } analysis;
   struct Output {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/output_schedule.hpp"
 #include "sheardiff/integrator/integrators.hpp"
 #include "sheardiff/observe/stress.hpp"
 #include "sheardiff/scene/scene.hpp"
@@ -65,9 +66,6 @@ struct RunInterrupted : std::runtime_error {
   int signal;
 };
 
-// The next frame (or checkpoint) strain after `strain`: `next` advanced by whole `spacing`s,
-// as repeated addition does, but in bounded time whatever the spacing.
-double next_output_strain(double next, double spacing, double strain);
 
 class RunDirectory;
 // How run_to_directory treats what DIR already holds (docs/stability.md, "Run directories"):

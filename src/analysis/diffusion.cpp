@@ -30,97 +30,291 @@ Eigen::MatrixXd bulk_mask(const Eigen::MatrixXd& y, const Eigen::VectorXd& botto
   return m;
 }
 
-DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixXd& vy,
-                                  double frame_strain, const DiffusionSettings& s,
-                                  const Eigen::MatrixXd* bulk) {
-  DiffusionReport r;
-  r.frame_strain = frame_strain;
-  r.frames = y.rows();
-  r.particles = y.cols();
-  if (r.frames < 4 || r.particles < 1)
-    throw std::invalid_argument(fmt::format(
-        "diffusion analysis: {} frames of {} particles in the measured window; at least 4 frames "
-        "are needed (run longer after steady state)",
-        r.frames, r.particles));
+namespace {
 
-  // MSD: lags up to the end of the fit window if the data allow, else as far as they go.
-  const long want = static_cast<long>(std::ceil(s.window_hi / frame_strain)) + 1;
-  const long max_lag = std::min(want, r.frames - 2);
-  const auto t0 = draw_reference_frames(0, r.frames, max_lag, s.reference_times, s.seed);
-  r.reference_times = static_cast<long>(t0.size());
-  r.msd = mean_square_displacement(y, frame_strain, max_lag, t0);
-  r.window_hi = std::min(s.window_hi, max_lag * frame_strain);
+// What the correlator's sums give once its quarter-blocks of origins are joined into `nb`
+// error blocks of `per_block` quarters (the last one takes the remainder): the correlation over
+// every origin and one with each block left out.
+struct JoinedSums {
+  std::vector<long> lag;                 // samples, lags that have pairs
+  std::vector<std::size_t> index;        // their index in the correlator
+  Eigen::RowVectorXd sum, count;         // over every origin
+  Eigen::MatrixXd block_sum, block_count;  // nb x lags
+};
+
+JoinedSums join_blocks(const MultipleTauCorrelator& c, long per_block, long nb, bool masked) {
+  JoinedSums j;
+  const auto& lags = c.lags();
+  for (std::size_t k = 0; k < lags.size(); ++k) {
+    double n = 0;
+    for (long b = 0; b < c.blocks(); ++b) n += c.count(b, k, false);
+    if (n > 0) j.lag.push_back(lags[k]), j.index.push_back(k);
+  }
+  const auto nl = static_cast<Eigen::Index>(j.lag.size());
+  j.block_sum = Eigen::MatrixXd::Zero(nb, nl);
+  j.block_count = Eigen::MatrixXd::Zero(nb, nl);
+  for (long b = 0; b < c.blocks(); ++b) {
+    const long B = std::min(nb - 1, b / per_block);
+    for (Eigen::Index k = 0; k < nl; ++k) {
+      j.block_sum(B, k) += c.sum(b, j.index[static_cast<std::size_t>(k)], masked);
+      j.block_count(B, k) += c.count(b, j.index[static_cast<std::size_t>(k)], masked);
+    }
+  }
+  j.sum = j.block_sum.colwise().sum();
+  j.count = j.block_count.colwise().sum();
+  return j;
+}
+
+std::vector<double> lag_strains(const std::vector<long>& lag, double dt) {
+  std::vector<double> t;
+  for (long k : lag) t.push_back(static_cast<double>(k) * dt);
+  return t;
+}
+
+double jackknife(const std::vector<double>& x) {
+  const auto n = static_cast<double>(x.size());
+  if (x.size() < 2) return std::nan("");
+  double mean = 0;
+  for (double v : x) {
+    if (!std::isfinite(v)) return std::nan("");
+    mean += v / n;
+  }
+  double s = 0;
+  for (double v : x) s += (v - mean) * (v - mean);
+  return std::sqrt((n - 1.0) / n * s);
+}
+
+// dv, Psi (every definition) and their delete-one-block jackknife errors, as
+// persistence_with_errors computes them from frames.
+PersistenceEstimate persistence_from(const JoinedSums& j, double dt) {
+  const auto correlation = [&](const Eigen::RowVectorXd& num, const Eigen::RowVectorXd& den) {
+    Autocorrelation c;
+    c.lag = lag_strains(j.lag, dt);
+    for (Eigen::Index k = 0; k < num.size(); ++k) c.c.push_back(den(k) > 0 ? num(k) / den(k) : 0.0);
+    return c;
+  };
+  PersistenceEstimate out;
+  out.blocks = j.block_sum.rows();
+  out.c = correlation(j.sum, j.count);
+  out.p = persistence_time(out.c);
+  out.dv = std::sqrt(out.p.c0);
+  const double nan = std::nan("");
+  out.dv_err = out.psi_err = out.psi_e_err = out.psi_zero_err = out.psi_full_err = nan;
+  if (out.blocks < 2) return out;
+  std::vector<double> dv, psi, psi_e, psi_zero, psi_full;
+  for (Eigen::Index B = 0; B < out.blocks; ++B) {
+    const Autocorrelation c =
+        correlation(j.sum - j.block_sum.row(B), j.count - j.block_count.row(B));
+    if (!(c.c[0] > 0.0)) {
+      for (auto* v : {&dv, &psi, &psi_e, &psi_zero, &psi_full}) v->push_back(nan);
+      continue;
+    }
+    const Persistence p = persistence_time(c);
+    dv.push_back(std::sqrt(p.c0));
+    psi.push_back(p.psi), psi_e.push_back(p.psi_e), psi_zero.push_back(p.psi_zero);
+    psi_full.push_back(p.psi_full);
+  }
+  out.dv_err = jackknife(dv);
+  out.psi_err = jackknife(psi);
+  out.psi_e_err = jackknife(psi_e);
+  out.psi_zero_err = jackknife(psi_zero);
+  out.psi_full_err = jackknife(psi_full);
+  return out;
+}
+
+MsdResult msd_from(const JoinedSums& j, double dt, double particles) {
+  MsdResult m;
+  m.lag = lag_strains(j.lag, dt);
+  for (Eigen::Index k = 0; k < j.sum.size(); ++k) {
+    m.msd.push_back(j.count(k) > 0 ? j.sum(k) / j.count(k) : std::nan(""));
+    m.samples.push_back(std::lround(j.count(k) / particles));
+  }
+  return m;
+}
+
+}  // namespace
+
+DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sample_strain,
+                                           long particles, bool bulk, bool non_affine_x)
+    : s_(s), dt_(sample_strain), particles_(particles), bulk_(bulk), x_(non_affine_x) {
+  if (!(sample_strain > 0.0) || particles < 1 || !(s.coarse_strain > 0.0) ||
+      !(s.error_block > 0.0) || !(s.window_hi > s.window_lo) || !(s.vacf_max_lag > 0.0))
+    throw std::invalid_argument(fmt::format(
+        "DiffusionAccumulator: sample spacing {} for {} particles, coarse spacing {}, error "
+        "block {}, window [{}, {}], VACF lag {}",
+        sample_strain, particles, s.coarse_strain, s.error_block, s.window_lo, s.window_hi,
+        s.vacf_max_lag));
+  // Origins are summed per quarter of an error block: a window too short for four whole
+  // blocks still gets four shorter ones.
+  mini_ = std::max(1L, std::lround(0.25 * s.error_block / dt_));
+  stride_ = std::max(1L, std::lround(s.coarse_strain / dt_));
+  const double dtc = static_cast<double>(stride_) * dt_;
+  const long vacf_lag = std::max(1L, static_cast<long>(std::ceil(s.vacf_max_lag / dt_ - 1e-9)));
+  const long msd_lag = static_cast<long>(std::ceil(s.window_hi / dt_ - 1e-9)) + 1;
+  const long band = std::max(static_cast<long>(std::ceil(s.window_hi / dtc - 1e-9)) + 1,
+                             std::max(2L, std::lround(s.error_block / dtc)));
+  using K = MultipleTauCorrelator::Kind;
+  // Only the VACF's error comes from its blocks (D's from the gram): the MSDs keep one block.
+  constexpr long kOneBlock = 1L << 62;
+  vacf_ = MultipleTauCorrelator(K::product, particles, vacf_lag, mini_, bulk);
+  msd_ = MultipleTauCorrelator(K::squared_difference, particles, msd_lag, kOneBlock, bulk);
+  if (x_)
+    msd_x_ = MultipleTauCorrelator(K::squared_difference, particles, msd_lag, kOneBlock, false);
+  coarse_ = IncrementGram(particles, band);
+}
+
+void DiffusionAccumulator::add(const double* y, const double* vy, const double* x,
+                               const std::uint8_t* bulk) {
+  if ((x != nullptr) != x_ || (bulk != nullptr) != bulk_)
+    throw std::invalid_argument("DiffusionAccumulator: a sample without the x or bulk data the "
+                                "accumulator was made for");
+  if (samples() % stride_ == 0) coarse_.add(y);
+  vacf_.add(vy, bulk);
+  msd_.add(y, bulk);
+  if (x_) msd_x_.add(x);
+  // From 16 quarters on, blocks are whole error blocks (report()): keep those only.
+  if (samples() == 16 * mini_ && vacf_.block() == mini_) vacf_.coarsen_blocks(4);
+}
+
+void DiffusionAccumulator::serialize(Archive& a) {
+  a.tag("diffusion_accumulator");
+  vacf_.serialize(a);
+  msd_.serialize(a);
+  if (x_) msd_x_.serialize(a);
+  coarse_.serialize(a);
+}
+
+DiffusionReport DiffusionAccumulator::report() const {
+  DiffusionReport r;
+  r.sample_strain = dt_;
+  r.coarse_strain = static_cast<double>(stride_) * dt_;
+  r.samples = samples();
+  r.particles = particles_;
+  const long coarse = coarse_.samples();
+  if (r.samples < 4 || coarse < 4)
+    throw std::invalid_argument(fmt::format(
+        "diffusion analysis: {} samples ({} of them {:g} strain apart) of {} particles in the "
+        "measured window; at least 4 of each are needed (run longer after steady state)",
+        r.samples, coarse, r.coarse_strain, r.particles));
+  const double dtc = r.coarse_strain;
+  const double measured = static_cast<double>(r.samples - 1) * dt_;
+
+  // D: every origin of the coarse samples, lags up to the end of the fit window if the data
+  // allow, else as far as they go.
+  const long want = static_cast<long>(std::ceil(s_.window_hi / dtc - 1e-9)) + 1;
+  const long max_lag = std::min({want, coarse - 2, coarse_.band()});
+  r.msd_coarse = coarse_.msd(dtc, max_lag);
+  r.window_hi = std::min(s_.window_hi, static_cast<double>(max_lag) * dtc);
   // Only a window cut short by the data moves its start (to keep some points in it).
-  r.window_lo = r.window_hi < s.window_hi ? std::min(s.window_lo, 0.5 * r.window_hi) : s.window_lo;
-  if (r.window_hi < s.window_hi)
+  r.window_lo = r.window_hi < s_.window_hi ? std::min(s_.window_lo, 0.5 * r.window_hi)
+                                           : s_.window_lo;
+  if (r.window_hi < s_.window_hi)
     r.warnings.push_back(fmt::format(
         "the measured window ({:.3g} strains) is shorter than the MSD fit window [{:g}, {:g}]: "
         "fitted over [{:.3g}, {:.3g}] instead",
-        (r.frames - 1) * frame_strain, s.window_lo, s.window_hi, r.window_lo, r.window_hi));
-  r.fit = fit_diffusion(r.msd, r.window_lo, r.window_hi);
+        measured, s_.window_lo, s_.window_hi, r.window_lo, r.window_hi));
+  r.fit = fit_diffusion(r.msd_coarse, r.window_lo, r.window_hi);
   if (std::isfinite(r.fit.loglog_slope) && std::abs(r.fit.loglog_slope - 1.0) > 0.2)
     r.warnings.push_back(
         fmt::format("the MSD is not diffusive in the fit window (log-log slope {:.3f}, 1 expected)",
                     r.fit.loglog_slope));
 
-  // Error bars: time blocks of s.error_block strain, at least 4 of them.
-  const double measured = static_cast<double>(r.frames - 1) * frame_strain;
-  r.error_block = std::min(s.error_block, measured / 4.0);
-  if (r.error_block < s.error_block)
+  // Error blocks: four quarters each, fewer when that leaves fewer than four blocks.
+  const long quarters = r.samples / mini_;
+  const long per_block = quarters >= 16 ? 4 : std::max(1L, quarters / 4);
+  const long block_samples = per_block * mini_;
+  const long nb = std::max(1L, r.samples / block_samples);
+  r.error_block = static_cast<double>(block_samples) * dt_;
+  if (r.error_block < 0.99 * s_.error_block)
     r.warnings.push_back(fmt::format(
-        "error bars from 4 blocks of {:.3g} strain (analysis.error_block = {:g} would leave "
+        "error bars from {} blocks of {:.3g} strain (analysis.error_block = {:g} would leave "
         "fewer than 4 in the measured window)",
-        r.error_block, s.error_block));
-  const long vlag =
-      std::min(static_cast<long>(std::ceil(s.vacf_max_lag / frame_strain)), r.frames - 1);
-  const long block_frames = std::max(1L, std::lround(r.error_block / frame_strain));
-  r.vel = persistence_with_errors(vy, frame_strain, vlag, block_frames);
+        nb, r.error_block, s_.error_block));
+
+  const auto parts = static_cast<double>(particles_);
+  const long vacf_per_block = block_samples / vacf_.block();  // correlator blocks per block
+  r.msd = msd_from(join_blocks(msd_, 1, 1, false), dt_, parts);
+  r.vel = persistence_from(join_blocks(vacf_, vacf_per_block, nb, false), dt_);
   r.vacf = r.vel.c;
   r.persistence = r.vel.p;
   r.dv = r.vel.dv;
   r.step_length = r.dv * r.persistence.psi;
   r.consistency = r.fit.d / (r.dv * r.dv * r.persistence.psi);
-  if (r.persistence.psi < 10.0 * frame_strain)
+  if (r.persistence.psi < 10.0 * dt_)
     r.warnings.push_back(fmt::format(
-        "C(tau) is under-resolved: Psi = {:.3g} strain is less than 10 frames ({:g} strain "
-        "each); lower output.frame_strain",
-        r.persistence.psi, frame_strain));
+        "C(tau) is under-resolved: Psi = {:.3g} strain is less than 10 samples ({:g} strain "
+        "each); lower analysis.sample_strain",
+        r.persistence.psi, dt_));
   if (r.error_block < 10.0 * r.persistence.psi)
     r.warnings.push_back(fmt::format(
         "error-bar blocks of {:.3g} strain are shorter than 10 Psi = {:.3g}: the errors may be "
         "underestimated (measure longer)",
         r.error_block, 10.0 * r.persistence.psi));
 
-  // D's error on frames ~0.05 strain apart (the MSD at lags of several strains needs no finer
-  // ones; at most ~1500 frames keep the quadratic form's matrices small).
-  long stride = std::max(1L, std::lround(0.05 / frame_strain));
-  stride = std::max(stride, (r.frames - 1 + 1499) / 1500);
-  {
-    const long coarse_frames = (r.frames - 1) / stride + 1;
-    Eigen::MatrixXd yc(coarse_frames, r.particles);
-    for (long k = 0; k < coarse_frames; ++k) yc.row(k) = y.row(k * stride);
-    const double dtc = frame_strain * static_cast<double>(stride);
+  // D's error bar from the same coarse samples, in blocks of the error-block length.
+  try {
     const long bc = std::max(2L, std::lround(r.error_block / dtc));
-    try {
-      r.d_error = msd_slope_error(yc, dtc, r.window_lo, r.window_hi, bc);
-    } catch (const std::invalid_argument& e) {
-      r.d_error.d = r.d_error.err = std::nan("");
-      r.warnings.push_back(fmt::format("no error bar for D: {}", e.what()));
-    }
+    r.d_error = msd_slope_error(coarse_, dtc, r.window_lo, r.window_hi, bc);
+  } catch (const std::invalid_argument& e) {
+    r.d_error.d = r.d_error.err = std::nan("");
+    r.warnings.push_back(fmt::format("no error bar for D: {}", e.what()));
   }
 
-  if (bulk) {
-    r.bulk_fraction = bulk->mean();
+  if (bulk_) {
+    const JoinedSums m = join_blocks(msd_, 1, 1, true);
+    r.bulk_fraction = m.count.size() > 0 && m.count(0) > 0
+                          ? m.count(0) / (parts * static_cast<double>(r.samples))
+                          : 0.0;
     if (r.bulk_fraction <= 0.0) {
       r.warnings.push_back("no disc is ever in the bulk: no bulk-only analysis");
     } else {
       r.has_bulk = true;
-      r.msd_bulk = masked_mean_square_displacement(y, *bulk, frame_strain, max_lag, t0);
-      r.fit_bulk = fit_diffusion(r.msd_bulk, r.window_lo, r.window_hi);
-      r.vel_bulk = persistence_with_errors(vy, frame_strain, vlag, block_frames, bulk);
+      r.msd_bulk = msd_from(m, dt_, parts);
+      try {
+        r.fit_bulk = fit_diffusion(r.msd_bulk, r.window_lo, r.window_hi);
+      } catch (const std::invalid_argument& e) {
+        r.fit_bulk.d = std::nan("");
+        r.warnings.push_back(fmt::format("no bulk D: {}", e.what()));
+      }
+      r.vel_bulk = persistence_from(join_blocks(vacf_, vacf_per_block, nb, true), dt_);
+    }
+  }
+  if (x_) {
+    r.has_x = true;
+    r.msd_x = msd_from(join_blocks(msd_x_, 1, 1, false), dt_, parts);
+    try {
+      r.fit_x = fit_diffusion(r.msd_x, r.window_lo, r.window_hi);
+    } catch (const std::invalid_argument& e) {
+      r.fit_x.d = r.fit_x.loglog_slope = std::nan("");
+      r.warnings.push_back(fmt::format("no x diffusion: {}", e.what()));
     }
   }
   return r;
+}
+
+DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixXd& vy,
+                                  double frame_strain, const DiffusionSettings& s,
+                                  const Eigen::MatrixXd* bulk) {
+  if (y.rows() != vy.rows() || y.cols() != vy.cols() ||
+      (bulk && (bulk->rows() != y.rows() || bulk->cols() != y.cols())))
+    throw std::invalid_argument("analyse_diffusion: y, vy and the bulk mask differ in shape");
+  if (y.rows() < 4 || y.cols() < 1)
+    throw std::invalid_argument(fmt::format(
+        "diffusion analysis: {} frames of {} particles in the measured window; at least 4 frames "
+        "are needed (run longer after steady state)",
+        y.rows(), y.cols()));
+  DiffusionAccumulator acc(s, frame_strain, static_cast<long>(y.cols()), bulk != nullptr, false);
+  // Frames as contiguous rows, as the run hands its samples over.
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMajor yr = y, vr = vy;
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(y.cols()));
+  for (Eigen::Index t = 0; t < y.rows(); ++t) {
+    if (bulk)
+      for (Eigen::Index i = 0; i < y.cols(); ++i)
+        mask[static_cast<std::size_t>(i)] = (*bulk)(t, i) != 0.0 ? 1 : 0;
+    acc.add(yr.row(t).data(), vr.row(t).data(), nullptr, bulk ? mask.data() : nullptr);
+  }
+  return acc.report();
 }
 
 void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
@@ -156,9 +350,13 @@ void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
     js["psi_e_bulk"] = number_or_null(r.vel_bulk.p.psi_e);
     js["psi_full_bulk"] = number_or_null(r.vel_bulk.p.psi_full);
   }
-  js["analysis_frames"] = r.frames;
-  js["analysis_frame_strain"] = r.frame_strain;
-  js["analysis_reference_times"] = r.reference_times;
+  if (r.has_x) {
+    js["D_x"] = number_or_null(r.fit_x.d);
+    js["msd_x_window_slope"] = number_or_null(r.fit_x.loglog_slope);
+  }
+  js["analysis_samples"] = r.samples;
+  js["analysis_sample_strain"] = r.sample_strain;
+  js["analysis_coarse_strain"] = r.coarse_strain;
   js["analysis_warnings"] = r.warnings;
 }
 
@@ -175,12 +373,21 @@ void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& 
   if (f < 0) fail("create");
   try {
     // Units and descriptions as docs/outputs.md gives them.
-    write_vector(f, "/msd/lag", r.msd.lag, "1/gammadot", "lag tau of the MSD, in strain");
+    write_vector(f, "/msd/lag", r.msd.lag, "1/gammadot",
+                 "lag tau of the MSD, in strain (the multiple-tau grid of the samples)");
     write_vector(f, "/msd/msd", r.msd.msd, "d^2",
                  "mean square displacement in the gradient direction y over the mobile discs and "
-                 "the reference times");
+                 "every origin on the lag's grid");
     write_vector(f, "/msd/samples", std::vector<double>(r.msd.samples.begin(), r.msd.samples.end()),
-                 "1", "number of (disc, reference time) pairs averaged at each lag");
+                 "1", "number of (disc, origin) pairs averaged at each lag, per disc");
+    write_vector(f, "/msd_coarse/lag", r.msd_coarse.lag, "1/gammadot",
+                 "lag tau of the coarse MSD (analysis.coarse_strain apart), in strain");
+    write_vector(f, "/msd_coarse/msd", r.msd_coarse.msd, "d^2",
+                 "the MSD in y over every origin of the coarse samples: the curve D is fitted to");
+    if (r.has_x)
+      write_vector(f, "/msd/msd_x", r.msd_x.msd, "d^2",
+                   "MSD of the x displacement relative to the imposed flow (integrated step by "
+                   "step), same lags as /msd/msd");
     write_vector(f, "/vacf/lag", r.vacf.lag, "1/gammadot", "lag tau of the VACF, in strain");
     write_vector(f, "/vacf/c", r.vacf.c, "(gammadot d)^2",
                  "velocity autocorrelation <v_y(t0) v_y(t0 + tau)> of the mobile discs, not "
@@ -208,7 +415,8 @@ void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& 
     write_attribute(root.id, "psi_err", r.vel.psi_err);
     write_attribute(root.id, "dv_err", r.vel.dv_err);
     write_attribute(root.id, "step_length", r.step_length);
-    write_attribute(root.id, "frame_strain", r.frame_strain);
+    write_attribute(root.id, "sample_strain", r.sample_strain);
+    write_attribute(root.id, "coarse_strain", r.coarse_strain);
     if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw std::runtime_error("flush");
   } catch (const std::exception&) {
     H5Fclose(f);

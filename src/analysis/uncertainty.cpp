@@ -69,13 +69,12 @@ BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& 
   return out;
 }
 
-MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, double hi,
-                              long block_frames) {
-  if (!(dt > 0.0) || block_frames < 2 || y.cols() < 1)
-    throw std::invalid_argument(fmt::format(
-        "msd_slope_error: need dt > 0, block_frames >= 2 and particles (got {}, {}, {})", dt,
-        block_frames, y.cols()));
-  const long increments = static_cast<long>(y.rows()) - 1;
+namespace {
+
+// The estimator's variance from G (at least n x n, the increments' products summed over
+// particles; only |k - l| below the window's longest lag and block_frames is read).
+MsdSlopeError slope_error_from_gram(const Eigen::MatrixXd& gram, long increments, double particles,
+                                    double dt, double lo, double hi, long block_frames) {
   MsdSlopeError out;
   out.block_frames = block_frames;
   out.blocks = increments / block_frames;
@@ -87,7 +86,6 @@ MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, do
   const long n = out.blocks * block_frames;
   const long frames = n + 1;
   out.increments_used = n;
-  const double particles = static_cast<double>(y.cols());
 
   // OLS slope weights of MSD(L) over the window's lags: slope = sum_L c_L MSD(L), D = slope/2.
   std::vector<long> lags;
@@ -120,9 +118,7 @@ MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, do
     }
     return w;
   };
-  Eigen::MatrixXd inc = y.middleRows(1, n) - y.topRows(n);
-  const Eigen::MatrixXd g = inc * inc.transpose();  // summed over particles
-  inc.resize(0, 0);
+  const auto g = gram.topLeftCorner(n, n);
   Eigen::MatrixXd w(n, n);
   for (long k = 0; k < n; ++k)
     for (long s = 0; k + s < n; ++s) w(k, k + s) = w(k + s, k) = w_of(k, s);
@@ -152,6 +148,114 @@ MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, do
       out.var_within += std::pow(wb.row(B).dot(h.row(C) - hbar), 2) / static_cast<double>(nb - 1);
   out.err = std::sqrt(out.var_between + out.var_within);
   return out;
+}
+
+}  // namespace
+
+MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, double hi,
+                              long block_frames) {
+  if (!(dt > 0.0) || block_frames < 2 || y.cols() < 1)
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: need dt > 0, block_frames >= 2 and particles (got {}, {}, {})", dt,
+        block_frames, y.cols()));
+  const long increments = static_cast<long>(y.rows()) - 1;
+  const long n = std::max(0L, increments / block_frames * block_frames);
+  const Eigen::MatrixXd inc = y.middleRows(1, n) - y.topRows(n);
+  return slope_error_from_gram(inc * inc.transpose(), increments, static_cast<double>(y.cols()),
+                               dt, lo, hi, block_frames);
+}
+
+IncrementGram::IncrementGram(long width, long band) : width_(width), band_(band) {
+  if (width < 1 || band < 1)
+    throw std::invalid_argument(
+        fmt::format("IncrementGram: width {} and band {} must be >= 1", width, band));
+  history_.assign(static_cast<std::size_t>((band + 1) * width), 0.0);
+  msd_sum_.assign(static_cast<std::size_t>(band + 1), 0.0);
+}
+
+void IncrementGram::add(const double* y) {
+  const auto w = static_cast<std::size_t>(width_);
+  const long slots = band_ + 1;
+  const auto at = [&](long t) { return history_.data() + (t % slots) * width_; };
+  const long n = samples_;
+  std::copy(y, y + w, at(n));
+  // MSD sums: every origin n - k with a partner at n.
+  for (long k = 1; k <= std::min(n, band_); ++k) {
+    const double* o = at(n - k);
+    double s = 0;
+    for (std::size_t i = 0; i < w; ++i) s += (y[i] - o[i]) * (y[i] - o[i]);
+    msd_sum_[static_cast<std::size_t>(k)] += s;
+  }
+  // The new increment l = n - 1 against itself and the band - 1 before it.
+  if (n >= 1) {
+    const long l = n - 1;
+    const double* a1 = at(l + 1);
+    const double* a0 = at(l);
+    for (long s = 0; s < band_; ++s) {
+      const long k = l - s;
+      double gkl = 0;
+      if (k >= 0) {
+        const double* b1 = at(k + 1);
+        const double* b0 = at(k);
+        for (std::size_t i = 0; i < w; ++i) gkl += (b1[i] - b0[i]) * (a1[i] - a0[i]);
+      }
+      g_.push_back(gkl);
+    }
+  }
+  ++samples_;
+}
+
+Eigen::MatrixXd IncrementGram::gram(long increments) const {
+  const long n = std::min(increments, std::max(0L, samples_ - 1));
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, n);
+  for (long l = 0; l < n; ++l)
+    for (long s = 0; s < band_ && s <= l; ++s)
+      g(l - s, l) = g(l, l - s) = g_[static_cast<std::size_t>(l * band_ + s)];
+  return g;
+}
+
+MsdResult IncrementGram::msd(double dt, long max_lag) const {
+  if (max_lag > band_ || max_lag >= samples_)
+    throw std::invalid_argument(fmt::format(
+        "IncrementGram::msd: lag {} beyond the band {} or the {} samples", max_lag, band_,
+        samples_));
+  MsdResult out;
+  for (long k = 0; k <= max_lag; ++k) {
+    const long pairs = width_ * (samples_ - k);
+    out.lag.push_back(static_cast<double>(k) * dt);
+    out.samples.push_back(pairs);
+    out.msd.push_back(k == 0 ? 0.0 : msd_sum_[static_cast<std::size_t>(k)] /
+                                         static_cast<double>(pairs));
+  }
+  return out;
+}
+
+MsdSlopeError msd_slope_error(const IncrementGram& g, double dt, double lo, double hi,
+                              long block_frames) {
+  if (!(dt > 0.0) || block_frames < 2)
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: need dt > 0 and block_frames >= 2 (got {}, {})", dt, block_frames));
+  // The gram holds |k - l| < band only: the window's lags and the blocks must fit in it.
+  if (static_cast<long>(std::floor(hi / dt + 1e-9)) > g.band() || block_frames > g.band())
+    throw std::invalid_argument(fmt::format(
+        "msd_slope_error: lags up to {} and blocks of {} need a band of that many increments; "
+        "the gram keeps {}",
+        hi, block_frames, g.band()));
+  const long increments = std::max(0L, g.samples() - 1);
+  return slope_error_from_gram(g.gram(increments / block_frames * block_frames), increments,
+                               static_cast<double>(g.width()), dt, lo, hi, block_frames);
+}
+
+void IncrementGram::serialize(Archive& a) {
+  a.tag("increment_gram");
+  long width = width_, band = band_;
+  a.io(width), a.io(band);
+  if (width != width_ || band != band_)
+    throw std::runtime_error(fmt::format(
+        "checkpoint: an increment gram of width {} and band {} where the configuration makes "
+        "{} and {}",
+        width, band, width_, band_));
+  a.io(samples_), a.io(history_), a.io(g_), a.io(msd_sum_);
 }
 
 PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt, long max_lag,

@@ -14,8 +14,9 @@ namespace sheardiff {
 
 namespace {
 
-// The digit is the state layout (CheckpointPayload::layout); 3, 4 and 5 share the header.
-constexpr char kMagic[] = "sheardiff-checkpoint-5";
+// The digit is the state layout (CheckpointPayload::layout); 3 to 6 share the header.
+constexpr char kMagic[] = "sheardiff-checkpoint-6";
+constexpr char kLayout5Magic[] = "sheardiff-checkpoint-5";
 constexpr char kLayout4Magic[] = "sheardiff-checkpoint-4";
 constexpr char kLayout3Magic[] = "sheardiff-checkpoint-3";
 constexpr char kLegacyMagic[] = "sheardiff-checkpoint-2";
@@ -93,6 +94,8 @@ CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
     out.layout = 3;
   else if (starts_with_magic(b, kLayout4Magic))
     out.layout = 4;
+  else if (starts_with_magic(b, kLayout5Magic))
+    out.layout = 5;
   else if (!starts_with_magic(b, kMagic))
     throw corrupt(
         fmt::format("it does not begin with the magic \"{}\" ({} bytes)", kMagic, b.size()));

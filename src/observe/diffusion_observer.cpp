@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 
+#include "sheardiff/core/output_schedule.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/text.hpp"
@@ -20,55 +21,95 @@ DiffusionSettings diffusion_settings(const Config& cfg) {
   DiffusionSettings s;
   s.window_lo = cfg.analysis.msd_window_lo;
   s.window_hi = cfg.analysis.msd_window_hi;
-  s.reference_times = cfg.analysis.reference_times;
   s.vacf_max_lag = cfg.analysis.vacf_max_lag;
   s.error_block = cfg.analysis.error_block;
-  s.seed = static_cast<std::uint64_t>(cfg.run.seed);
+  s.coarse_strain = cfg.analysis.coarse_strain;
   return s;
 }
 
 DiffusionObserver::DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
                                      std::function<bool(const Dynamics&)> measuring)
     : settings_(diffusion_settings(cfg)),
-      frame_strain_(cfg.output.frame_strain),
+      sample_strain_(cfg.analysis.sample_strain),
+      next_sample_(cfg.analysis.sample_strain),
       file_(std::move(analysis_file)),
       measuring_(std::move(measuring)),
       exclusion_(cfg.observables.wall_exclusion) {}
 
-void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
+void DiffusionObserver::on_step(const StepView& v) {
   const Dynamics& d = v.dynamics;
-  if (!measuring_(d)) return;
+  const bool measuring = measuring_(d);
   const Particles& p = d.particles();
-  const double gd = d.flow().gammadot;
-  for (std::size_t i = 0; i < p.n_mobile; ++i) {
-    y_.push_back(p.unwrapped[i].y());
-    vy_.push_back(v.velocities.u[i].y() / gd);
-  }
-  if (d.walls()) {
-    bottom_.push_back(mean_height(p, d.walls()->bottom));
-    top_.push_back(mean_height(p, d.walls()->top));
-  }
-  ++frames_;
-}
-
-void DiffusionObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
-  const auto n = static_cast<Eigen::Index>(d.particles().n_mobile);
-  if (frames_ < 4) {
-    js["analysis_warnings"] = {
-        fmt::format("no diffusion analysis: only {} frames in the measured window", frames_)};
+  // The x displacement relative to the imposed flow, integrated over every step of the window.
+  if (measuring && particles_ > 0)
+    for (std::size_t i = 0; i < p.n_mobile; ++i)
+      x_[i] += (v.velocities.u[i].x() - d.flow().velocity(p.position[i]).x()) * v.dt;
+  // Samples are due on the same grid as frames (the first step at or past each mark).
+  if (!output_due(next_sample_, d.strain())) return;
+  const double next = next_output_strain(next_sample_, sample_strain_, d.strain());
+  const long marks = std::lround((next - next_sample_) / sample_strain_);
+  next_sample_ = next;
+  if (!measuring) {
+    // The pressure cell opens its window in on_frame (steady state detected at a frame): a
+    // sample due at this step is taken there, once the window is open.
+    due_at_step_ = d.steps();
     return;
   }
-  // Row-major buffers (one frame per row) mapped as frames x particles.
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::MatrixXd y = Eigen::Map<const RowMajor>(y_.data(), frames_, n);
-  const Eigen::MatrixXd vy = Eigen::Map<const RowMajor>(vy_.data(), frames_, n);
-  Eigen::MatrixXd mask;
-  if (static_cast<long>(bottom_.size()) == frames_ && frames_ > 0)
-    mask = bulk_mask(y, Eigen::Map<const Eigen::VectorXd>(bottom_.data(), frames_),
-                     Eigen::Map<const Eigen::VectorXd>(top_.data(), frames_), exclusion_);
+  if (particles_ > 0) skipped_ += std::max(0L, marks - 1);
+  take_sample(v);
+}
+
+void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
+  if (due_at_step_ != v.dynamics.steps() || !measuring_(v.dynamics)) return;
+  due_at_step_ = -1;
+  take_sample(v);
+}
+
+void DiffusionObserver::take_sample(const StepView& v) {
+  const Dynamics& d = v.dynamics;
+  const Particles& p = d.particles();
+  if (particles_ == 0) {
+    particles_ = static_cast<long>(p.n_mobile);
+    walls_ = d.walls().has_value();
+    acc_ = DiffusionAccumulator(settings_, sample_strain_, particles_, walls_, true);
+    x_.assign(p.n_mobile, 0.0);
+  }
+  const auto n = static_cast<std::size_t>(particles_);
+  y_.resize(n), vy_.resize(n), bulk_.resize(n);
+  const double gd = d.flow().gammadot;
+  for (std::size_t i = 0; i < n; ++i) {
+    y_[i] = p.unwrapped[i].y();
+    vy_[i] = v.velocities.u[i].y() / gd;
+  }
+  if (walls_) {
+    // As bulk_mask does with the frames' wall centre lines.
+    const double bottom = mean_height(p, d.walls()->bottom);
+    const double top = mean_height(p, d.walls()->top);
+    for (std::size_t i = 0; i < n; ++i)
+      bulk_[i] = y_[i] >= bottom + exclusion_ && y_[i] <= top - exclusion_ ? 1 : 0;
+  }
+  acc_.add(y_.data(), vy_.data(), x_.data(), walls_ ? bulk_.data() : nullptr);
+}
+
+void DiffusionObserver::serialize(Archive& a) {
+  a.tag("diffusion_samples");
+  a.io(next_sample_), a.io(particles_), a.io(walls_), a.io(skipped_), a.io(x_);
+  if (a.loading() && particles_ > 0)
+    acc_ = DiffusionAccumulator(settings_, sample_strain_, particles_, walls_, true);
+  if (particles_ > 0) acc_.serialize(a);
+}
+
+void DiffusionObserver::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*) {
   try {
-    const DiffusionReport r =
-        analyse_diffusion(y, vy, frame_strain_, settings_, mask.size() ? &mask : nullptr);
+    if (particles_ == 0)
+      throw std::invalid_argument("no sample was taken in the measured window");
+    DiffusionReport r = acc_.report();
+    if (skipped_ > 0)
+      r.warnings.push_back(fmt::format(
+          "{} of {} sample marks fell in a step that already crossed one: the samples are "
+          "further apart than analysis.sample_strain = {:g} there; raise it above the step's "
+          "strain",
+          skipped_, skipped_ + r.samples, sample_strain_));
     add_to_summary(r, js);
     if (!file_.empty()) write_analysis_file(r, file_);
   } catch (const std::invalid_argument& e) {

@@ -31,7 +31,7 @@ checkpoint_strain = 0.4
 [analysis]
 msd_window_lo = 0.2
 msd_window_hi = 0.5
-reference_times = 20
+sample_strain = 0.004
 TOML
 "$bin" run run.toml --out ref > /dev/null 2>&1 || fail "reference run"
 full_kb=$(du -sk --apparent-size ref | cut -f1)

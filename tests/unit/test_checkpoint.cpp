@@ -34,11 +34,17 @@ fs::path binary() {
 }
 
 // A small pressure-cell run with every observer on, long enough to be killed in the middle.
-fs::path write_config(const fs::path& dir, const std::string& scene = "pressure_shear") {
+fs::path write_config(const fs::path& dir, const std::string& scene = "pressure_shear",
+                      bool diffusion = true) {
   fs::create_directories(dir);
   const auto file = dir / "run.toml";
   std::ofstream(file) << "[scene]\ntype = \"" << scene << "\"\n"
-                      << R"([particles]
+                      << "[analysis]\ndiffusion = " << (diffusion ? "true" : "false") << "\n"
+                      << R"(msd_window_lo = 0.1
+msd_window_hi = 0.3
+reference_times = 20
+vacf_max_lag = 0.2
+[particles]
 N = 80
 phi_init = 0.72
 [flow]
@@ -50,11 +56,6 @@ strain = 2.0
 seed = 4
 [steady]
 window = 0.5
-[analysis]
-msd_window_lo = 0.1
-msd_window_hi = 0.3
-reference_times = 20
-vacf_max_lag = 0.2
 [output]
 frame_strain = 0.02
 checkpoint_strain = 0.1
@@ -463,12 +464,13 @@ TEST(Checkpoint, ArchiveLengthsAreBoundedByTheFile) {
 }
 
 // Checkpoints of sheardiff before issue 16 (version 2: no header, no checksum, no solver
-// counters) still resume, with a warning, to the same results: those of a simple-shear run,
-// whose state layout has not changed since (a pressure cell's has: the next test).
+// counters) still resume, with a warning, to the same results: those of a simple-shear run
+// without the diffusion analysis, whose state layout has not changed since (a pressure cell's
+// has, and so has the diffusion analysis's: the next tests).
 TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   const fs::path root = fs::temp_directory_path() / "sheardiff_test_v2";
   fs::remove_all(root);
-  const fs::path cfg = write_config(root, "simple_shear");
+  const fs::path cfg = write_config(root, "simple_shear", /*diffusion=*/false);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
   const std::vector<char> v3 = bytes_of(root / "old" / "checkpoint.bin");
@@ -505,7 +507,7 @@ TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
-  const std::string now = "sheardiff-checkpoint-5", before = "sheardiff-checkpoint-3";
+  const std::string now = "sheardiff-checkpoint-6", before = "sheardiff-checkpoint-3";
   ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
   std::memcpy(bytes.data() + 8, before.data(), before.size());  // the CRC covers the payload only
   write_bytes(root / "old" / "checkpoint.bin", bytes);
@@ -513,6 +515,29 @@ TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
   const std::string err = text_of(root / "err.txt");
   EXPECT_NE(err.find("earlier sheardiff (checkpoint layout 3)"), std::string::npos) << err;
   EXPECT_NE(err.find("run.log"), std::string::npos) << err;
+  EXPECT_EQ(bytes_of(root / "old" / "checkpoint.bin"), bytes);
+  fs::remove_all(root);
+}
+
+// A checkpoint of layout 5 kept the measured window's frames for the diffusion analysis; this
+// version accumulates it while running, so such a state cannot be continued: refused with that
+// reason and the way out, exit 2, the file left as it was.
+TEST(Checkpoint, FrameKeepingDiffusionLayoutIsRefusedWithItsReason) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_layout5";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root, "simple_shear");
+  make_interrupted_run(cfg, root / "old");
+  std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
+  const std::string now = "sheardiff-checkpoint-6", before = "sheardiff-checkpoint-5";
+  ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
+  std::memcpy(bytes.data() + 8, before.data(), before.size());
+  write_bytes(root / "old" / "checkpoint.bin", bytes);
+  EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 2);
+  const std::string err = text_of(root / "err.txt");
+  EXPECT_NE(err.find("(checkpoint layout 5), which kept the measured window's frames"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
   EXPECT_EQ(bytes_of(root / "old" / "checkpoint.bin"), bytes);
   fs::remove_all(root);
 }

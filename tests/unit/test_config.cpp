@@ -66,6 +66,8 @@ void expect_same_config(Config a, Config b) {
   EXPECT_EQ(a.analysis.msd_window_hi, b.analysis.msd_window_hi);
   EXPECT_EQ(a.analysis.reference_times, b.analysis.reference_times);
   EXPECT_EQ(a.analysis.vacf_max_lag, b.analysis.vacf_max_lag);
+  EXPECT_EQ(a.analysis.sample_strain, b.analysis.sample_strain);
+  EXPECT_EQ(a.analysis.coarse_strain, b.analysis.coarse_strain);
 }
 
 // The message of the ConfigError thrown by parse_config, or "" (and a failure) if none is.
@@ -189,6 +191,8 @@ TEST(Config, ToTomlRoundTrips) {
   c.observables.wall_exclusion = 2.0;
   c.observables.profile_bin = 0.25;
   c.output.frame_strain = 0.02;
+  c.analysis.sample_strain = 0.003;
+  c.analysis.coarse_strain = 0.07;
   c.output.velocities = false;
   c.output.trajectory = false;
   const std::string text = to_toml(c);

@@ -25,9 +25,11 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   c.run.strain = 1.5;
   c.run.transient_strain = 0.3;
   c.output.frame_strain = 0.01;
+  // The samples are the frames, so that analyse can see them again.
+  c.analysis.sample_strain = 0.01;
+  c.analysis.coarse_strain = 0.01;
   c.analysis.msd_window_lo = 0.2;
   c.analysis.msd_window_hi = 0.5;
-  c.analysis.reference_times = 50;
   c.analysis.vacf_max_lag = 0.3;
   const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_diffusion_run";
   std::filesystem::remove_all(dir);
@@ -40,7 +42,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   const nlohmann::json& after = re.summary;
   for (const char* key :
        {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
-        "msd_window_slope", "analysis_frames", "diffusion_consistency"})
+        "msd_window_slope", "analysis_samples", "diffusion_consistency"})
     EXPECT_EQ(during[key], after[key]) << key;
   // Physical sanity of the numbers themselves: a sheared suspension diffuses and fluctuates.
   EXPECT_GT(during["D"].get<double>(), 0.0);
@@ -48,7 +50,10 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   EXPECT_GT(during["psi"].get<double>(), 0.0);
   // Frames are written at the first step past each multiple of 0.01, so the one at 0.3 lies just
   // past the transient: 0.30, 0.31, ..., 1.50.
-  EXPECT_EQ(during["analysis_frames"].get<long>(), 121);
+  EXPECT_EQ(during["analysis_samples"].get<long>(), 121);
+  // The x displacement relative to the imposed flow was sampled too (analyse cannot: frames
+  // do not integrate it), and its MSD is positive.
+  EXPECT_GT(during["D_x"].get<double>(), 0.0);
 
   // Another analysis setting (issue 34: analyse took no --set) analyses the same frames into
   // DIR/reanalysis/, saying so, and leaves the run's summary as it was; a key that changes the
@@ -62,6 +67,40 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   EXPECT_EQ(written["analysed_with"][0], "analysis.msd_window_lo=0.25");
   EXPECT_TRUE(std::filesystem::exists(dir / "reanalysis" / "analysis.h5"));
   EXPECT_THROW(reanalyse_run(dir, {"flow.J=0.2"}), ConfigError);
+  std::filesystem::remove_all(dir);
+}
+
+// A run sampled more finely than its frames (the default: ten samples per frame) cannot be
+// re-analysed to the same numbers from its trajectory: analyse recomputes from the frames into
+// DIR/reanalysis/, naming the keys that differ, and leaves the run's files alone.
+TEST(DiffusionRun, FinerSamplesThanFramesAnalyseBeside) {
+  Config c;
+  c.particles.n = 60;
+  c.particles.phi_init = 0.7;
+  c.flow.j = 1e-1;
+  c.contact.ktilde = 1e3;
+  c.run.strain = 1.5;
+  c.run.transient_strain = 0.3;
+  c.output.frame_strain = 0.02;
+  c.analysis.coarse_strain = 0.02;
+  c.analysis.msd_window_lo = 0.2;
+  c.analysis.msd_window_hi = 0.5;
+  c.analysis.vacf_max_lag = 0.3;
+  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_finer_samples";
+  std::filesystem::remove_all(dir);
+  const nlohmann::json during = run_to_directory(c, dir, false);
+  EXPECT_DOUBLE_EQ(during["analysis_sample_strain"].get<double>(), 0.002);
+  EXPECT_GE(during["analysis_samples"].get<long>(), 590);
+  const std::string before = file_text(dir / "summary.json");
+  const Reanalysis re = reanalyse_run(dir);
+  EXPECT_EQ(re.folder, dir / "reanalysis");
+  EXPECT_NE(std::find(re.differs.begin(), re.differs.end(), "psi"), re.differs.end());
+  EXPECT_EQ(file_text(dir / "summary.json"), before);
+  // The same physics from coarser samples: Psi within a few of its own error bars.
+  const auto frames = nlohmann::json::parse(file_text(dir / "reanalysis" / "summary.json"));
+  EXPECT_EQ(frames["analysis_sample_strain"].get<double>(), 0.02);
+  EXPECT_NEAR(frames["psi"].get<double>(), during["psi"].get<double>(),
+              0.25 * during["psi"].get<double>());
   std::filesystem::remove_all(dir);
 }
 
@@ -87,11 +126,12 @@ Config small_cell(bool diffusion) {
   c.steady.mu_tolerance = 0.3;
   c.steady.measure_strain = 2.0;
   c.output.frame_strain = 0.02;
+  c.analysis.sample_strain = 0.02;
+  c.analysis.coarse_strain = 0.02;
   c.analysis.error_block = 0.5;
   c.analysis.diffusion = diffusion;
   c.analysis.msd_window_lo = 0.2;
   c.analysis.msd_window_hi = 0.5;
-  c.analysis.reference_times = 30;
   c.analysis.vacf_max_lag = 0.3;
   return c;
 }

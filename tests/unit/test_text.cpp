@@ -198,6 +198,8 @@ TEST(Text, ResolvedConfigHasShortestFloatsAndRoundTrips) {
     c.contact.mu = 10.0 * u(rng);
     c.run.strain = 1.0 + 1e3 * u(rng);
     c.output.frame_strain = c.run.strain * (1e-3 + u(rng) * 0.5);
+    c.analysis.sample_strain = std::min(1.0, c.output.frame_strain / 7.0);
+    c.analysis.coarse_strain = c.analysis.msd_window_hi / (5.0 + 100.0 * u(rng));
     const std::string t = to_toml(c);
     const Config back = parse_config(t, "random.toml");
     for (const auto& [a, b] : {std::pair{back.particles.phi_init, c.particles.phi_init},

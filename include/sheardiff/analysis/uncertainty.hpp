@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sheardiff/analysis/time_series.hpp"
+#include "sheardiff/core/archive.hpp"
 
 namespace sheardiff {
 
@@ -41,6 +42,36 @@ struct MsdSlopeError {
   long blocks = 0, block_frames = 0, increments_used = 0;
 };
 MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, double hi,
+                              long block_frames);
+
+// What msd_slope_error needs of a series, accumulated sample by sample without keeping it: the
+// products of its increments summed over particles, G(k, l) = sum_i (y_i(k+1) - y_i(k))
+// (y_i(l+1) - y_i(l)) for |k - l| < band, and the every-origin MSD sums up to lag band. Memory:
+// band + 1 samples, and band numbers per sample (independent of the particle count).
+class IncrementGram {
+ public:
+  IncrementGram() = default;
+  IncrementGram(long width, long band);
+  void add(const double* y);
+  long samples() const { return samples_; }
+  long width() const { return width_; }
+  long band() const { return band_; }
+  // G over the first `increments` increments, zero where |k - l| >= band.
+  Eigen::MatrixXd gram(long increments) const;
+  // The MSD at lags 0 .. max_lag (<= band) over every origin, as mean_square_displacement.
+  MsdResult msd(double dt, long max_lag) const;
+  void serialize(Archive& a);
+
+ private:
+  long width_ = 0, band_ = 0, samples_ = 0;
+  std::vector<double> history_;  // the last band + 1 samples
+  std::vector<double> g_;        // per increment l: G(l - s, l), s = 0 .. band - 1
+  std::vector<double> msd_sum_;  // per lag 0 .. band
+};
+
+// msd_slope_error of the series the gram accumulated (equal to round-off); the window's
+// longest lag and block_frames must lie within its band.
+MsdSlopeError msd_slope_error(const IncrementGram& g, double dt, double lo, double hi,
                               long block_frames);
 
 // The velocity autocorrelation of v (frames x particles) summed separately for each block of

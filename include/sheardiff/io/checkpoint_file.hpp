@@ -1,7 +1,7 @@
 #pragma once
 // The file format of DIR/checkpoint.bin: a header, then the run's archived state (Archive).
 //
-//   u64 22, "sheardiff-checkpoint-5"   (the magic, as Archive writes a string; the digit is
+//   u64 22, "sheardiff-checkpoint-6"   (the magic, as Archive writes a string; the digit is
 //                                        the layout of the state that follows)
 //   u64 payload length in bytes
 //   u32 CRC-32 (zlib) of the payload
@@ -36,7 +36,7 @@ std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload);
 struct CheckpointPayload {
   std::vector<char> bytes;  // the archived state, after the magic
   bool checksummed = true;  // false: a version 2 file, read without a check
-  int layout = 5;           // the state layout: 2 to 5 (the magic's digit)
+  int layout = 6;           // the state layout: 2 to 6 (the magic's digit)
 };
 
 // Reads and checks FILE: the magic, the length against the file size, the CRC. Throws

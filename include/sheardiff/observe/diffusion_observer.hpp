@@ -12,30 +12,39 @@ namespace sheardiff {
 
 DiffusionSettings diffusion_settings(const Config& cfg);
 
-// Keeps, for every frame of the measured window, the unwrapped y and v_y / gammadot of the
-// mobile particles, and analyses them at the end of the run (analyse_diffusion). The frames are
-// exactly those written to the trajectory, so `sheardiff analyse DIR` recomputes the same numbers.
+// Samples the mobile discs every analysis.sample_strain of the measured window (the unwrapped
+// y, v_y / gammadot, the x displacement relative to the imposed flow and, with walls, whether
+// each disc is in the bulk) into a DiffusionAccumulator, and analyses them at the end of the
+// run. Nothing grows with the window: the checkpoint carries the accumulator. With
+// analysis.sample_strain = output.frame_strain the samples are the trajectory's frames, and
+// `sheardiff analyse DIR` recomputes the same numbers from them.
 class DiffusionObserver final : public Observer {
  public:
-  // measuring(d): whether the frame belongs to the measured window.
+  // measuring(d): whether the run is in the measured window.
   DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
                     std::function<bool(const Dynamics&)> measuring);
+  void on_step(const StepView& v) override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
-  void serialize(Archive& a) override {
-    a.tag("diffusion");
-    a.io(y_), a.io(vy_), a.io(frames_), a.io(bottom_), a.io(top_);
-  }
+  void serialize(Archive& a) override;
 
  private:
+  void take_sample(const StepView& v);
+
   DiffusionSettings settings_;
-  double frame_strain_;
+  double sample_strain_;
+  double next_sample_;
   std::filesystem::path file_;
   std::function<bool(const Dynamics&)> measuring_;
-  std::vector<double> y_, vy_;
-  long frames_ = 0;
   double exclusion_;
-  std::vector<double> bottom_, top_;  // wall centre lines per frame (scenes with walls)
+  long particles_ = 0;   // 0 until the first sample
+  bool walls_ = false;   // samples carry a bulk mask
+  long skipped_ = 0;     // sample marks that fell inside one step with another
+  long due_at_step_ = -1;  // a sample was due at this step before the window opened
+  std::vector<double> x_;  // x displacement relative to the imposed flow since the first sample
+  DiffusionAccumulator acc_;
+  std::vector<double> y_, vy_;
+  std::vector<std::uint8_t> bulk_;
 };
 
 // What `sheardiff analyse DIR` found: the run's summary with every recomputed key, and where it
