@@ -46,9 +46,9 @@ const char* to_string(MixRule m) {
 
 namespace {
 
-using Value = std::variant<double, std::int64_t, bool, std::string>;
+using Value = std::variant<double, std::int64_t, bool, std::string, std::vector<double>>;
 
-enum class Kind { Real, Integer, Boolean, Text, Choice };
+enum class Kind { Real, Integer, Boolean, Text, Choice, RealList };
 
 struct KeySpec {
   std::string key;  // "section.name"
@@ -90,6 +90,18 @@ KeySpec boolean(std::string key, T Config::*sec, bool T::*field, std::string doc
       std::move(key), Kind::Boolean, -kInf, kInf, false, false, {}, "", std::move(doc), {}, {}};
   k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
   k.set = [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<bool>(v); };
+  return k;
+}
+// A list of numbers, each in the range (an empty list allowed).
+template <typename T>
+KeySpec real_list(std::string key, T Config::*sec, std::vector<double> T::*field, double lo,
+                  double hi, bool lo_open, std::string unit, std::string doc) {
+  KeySpec k{std::move(key),  Kind::RealList, lo, hi, lo_open, false, {},
+            std::move(unit), std::move(doc), {}, {}};
+  k.get = [sec, field](const Config& c) { return Value{c.*sec.*field}; };
+  k.set = [sec, field](Config& c, const Value& v) {
+    c.*sec.*field = std::get<std::vector<double>>(v);
+  };
   return k;
 }
 template <typename T>
@@ -335,6 +347,12 @@ const std::vector<KeySpec>& schema() {
                      "Strain between two samples of the diffusion analysis, taken during the run "
                      "(independent of the trajectory); 0 = output.frame_strain / 10, i.e. ~100 "
                      "samples per persistence time."));
+    s.push_back(real_list(
+        "analysis.velocity_intervals", &C::analysis, &C::Analysis::velocity_intervals, 0.0, 1.0,
+        true, "1 (strain)",
+        "Also report dv and Psi of the displacement velocity (y(t + Delta) - y(t)) / Delta for "
+        "each interval Delta here (rounded to the analysis's grid), beside those of the "
+        "instantaneous velocities; e.g. [0.0035, 0.01]. Each costs ~80 samples of memory."));
     s.push_back(real("analysis.coarse_strain", &C::analysis, &C::Analysis::coarse_strain, 0.0, 1e3,
                      false, "1 (strain)",
                      "Strain between the samples D and its error bar are fitted to (every one "
@@ -437,6 +455,9 @@ std::string range_text(const KeySpec& k) {
     case Kind::Real:
       return fmt::format("a number in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo, k.hi,
                          k.hi_open ? ")" : "]");
+    case Kind::RealList:
+      return fmt::format("a list of numbers in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo,
+                         k.hi, k.hi_open ? ")" : "]");
   }
   return "";
 }
@@ -453,8 +474,11 @@ std::string describe(const toml::node& n) {
     os << toml_float(*n.value<double>());
   else if (n.is_table())
     os << "a table";
-  else if (n.is_array())
-    os << "an array";
+  else if (const auto* a = n.as_array()) {
+    os << '[';
+    for (std::size_t i = 0; i < a->size(); ++i) os << (i ? ", " : "") << describe(*a->get(i));
+    os << ']';
+  }
   else
     n.visit([&](const auto& v) { os << v; });
   return os.str();
@@ -489,6 +513,20 @@ Value convert(const toml::node& node, const KeySpec& k, const std::string& origi
       if (!node.is_string()) bad();
       v = *node.value<std::string>();
       break;
+    case Kind::RealList: {
+      const auto* list = node.as_array();
+      if (!list) bad();
+      std::vector<double> xs;
+      for (const auto& item : *list) {
+        if (!item.is_number()) bad();
+        const double x = item.is_integer() ? static_cast<double>(*item.value<std::int64_t>())
+                                           : *item.value<double>();
+        if (!std::isfinite(x) || x < k.lo || x > k.hi || (k.lo_open && x == k.lo)) bad();
+        xs.push_back(x);
+      }
+      v = xs;
+      break;
+    }
   }
   if (k.kind == Kind::Real || k.kind == Kind::Integer) {
     const double x =
@@ -703,7 +741,11 @@ std::string toml_value(const Value& v) {
           return x ? "true" : "false";
         else if constexpr (std::is_same_v<T, double>)
           return toml_float(x);
-        else
+        else if constexpr (std::is_same_v<T, std::vector<double>>) {
+          std::string out = "[";
+          for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + toml_float(x[i]);
+          return out + "]";
+        } else
           return fmt::format("{}", x);
       },
       v);
@@ -716,10 +758,11 @@ std::string default_text(const Value& v) {
 }
 
 const char* type_name(Kind kind) {
-  return kind == Kind::Real      ? "real"
-         : kind == Kind::Integer ? "integer"
-         : kind == Kind::Boolean ? "bool"
-                                 : "string";
+  return kind == Kind::Real       ? "real"
+         : kind == Kind::Integer  ? "integer"
+         : kind == Kind::Boolean  ? "bool"
+         : kind == Kind::RealList ? "list of reals"
+                                  : "string";
 }
 
 std::pair<std::string, std::string> split_key(const std::string& key) {

@@ -110,6 +110,7 @@ struct Config {
     double error_block = 3.0;   // strain: time blocks of the error bars
     double sample_strain = 0.0;  // strain between samples; 0 = output.frame_strain / 10
     double coarse_strain = 0.0;  // strain between the samples D comes from; 0 = auto
+    std::vector<double> velocity_intervals;  // strain: displacement-velocity definitions
   } analysis;
   struct Output {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi

@@ -135,6 +135,21 @@ void MultipleTauCorrelator::add(const double* x, const std::uint8_t* mask) {
   ++samples_;
 }
 
+const double* MultipleTauCorrelator::past(long age) const {
+  const long n = samples_ - 1, t = n - age;
+  if (age < 0 || t < 0) return nullptr;
+  const long half = points_ / 2;
+  if (age < points_) return history_[0].data() + (t % points_) * width_;
+  for (int l = 1; l < levels_; ++l) {
+    const long step = 1L << l;
+    if (age % step != 0 || n % step != 0) return nullptr;
+    const long k = age >> l;
+    if (k >= half && k < points_)
+      return history_[static_cast<std::size_t>(l)].data() + ((t >> l) % half) * width_;
+  }
+  return nullptr;
+}
+
 void MultipleTauCorrelator::coarsen_blocks(long factor) {
   if (factor < 1) throw std::invalid_argument("MultipleTauCorrelator: coarsen by less than 1");
   const std::size_t nlags = lags_.size();

@@ -132,6 +132,20 @@ MsdResult msd_from(const JoinedSums& j, double dt, double particles) {
   return m;
 }
 
+// Error blocks over `samples` samples whose origins were summed per `mini` (a quarter of
+// analysis.error_block): four quarters each, fewer when that leaves fewer than four blocks.
+struct ErrorBlocks {
+  long block_samples = 1, blocks = 1;
+};
+ErrorBlocks error_blocks(long samples, long mini) {
+  const long quarters = samples / mini;
+  const long per_block = quarters >= 16 ? 4 : std::max(1L, quarters / 4);
+  ErrorBlocks b;
+  b.block_samples = per_block * mini;
+  b.blocks = std::max(1L, samples / b.block_samples);
+  return b;
+}
+
 }  // namespace
 
 DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sample_strain,
@@ -161,6 +175,23 @@ DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sa
   if (x_)
     msd_x_ = MultipleTauCorrelator(K::squared_difference, particles, msd_lag, kOneBlock, false);
   coarse_ = IncrementGram(particles, band);
+  for (double delta : s.velocity_intervals) {
+    // Delta as k 2^l samples with k <= 15 (k >= 8 above level 0): what the MSD's grid keeps.
+    Interval iv;
+    const double m = delta / dt_;
+    while (m / static_cast<double>(1L << iv.level) >= 15.5) ++iv.level;
+    iv.k = std::max(1L, std::lround(m / static_cast<double>(1L << iv.level)));
+    if ((iv.k << iv.level) > msd_lag)
+      throw std::invalid_argument(fmt::format(
+          "analysis.velocity_intervals: {:g} is longer than the MSD's lags (analysis."
+          "msd_window_hi = {:g})",
+          delta, s.window_hi));
+    const double spacing = static_cast<double>(1L << iv.level) * dt_;
+    iv.mini = std::max(1L, std::lround(0.25 * s.error_block / spacing));
+    const long lag = std::max(1L, static_cast<long>(std::ceil(s.vacf_max_lag / spacing - 1e-9)));
+    iv.c = MultipleTauCorrelator(K::product, particles, lag, iv.mini, false);
+    intervals_.push_back(std::move(iv));
+  }
 }
 
 void DiffusionAccumulator::add(const double* y, const double* vy, const double* x,
@@ -169,9 +200,21 @@ void DiffusionAccumulator::add(const double* y, const double* vy, const double* 
     throw std::invalid_argument("DiffusionAccumulator: a sample without the x or bulk data the "
                                 "accumulator was made for");
   if (samples() % stride_ == 0) coarse_.add(y);
+  const long n = samples();
   vacf_.add(vy, bulk);
   msd_.add(y, bulk);
   if (x_) msd_x_.add(x);
+  for (Interval& iv : intervals_) {
+    const long step = 1L << iv.level, span = iv.k << iv.level;
+    if (n % step != 0 || n < span) continue;
+    const double* before = msd_.past(span);
+    const double delta = static_cast<double>(span) * dt_;
+    u_.resize(static_cast<std::size_t>(particles_));
+    for (long i = 0; i < particles_; ++i)
+      u_[static_cast<std::size_t>(i)] = (y[i] - before[i]) / delta;
+    iv.c.add(u_.data());
+    if (iv.c.samples() == 16 * iv.mini && iv.c.block() == iv.mini) iv.c.coarsen_blocks(4);
+  }
   // From 16 quarters on, blocks are whole error blocks (report()): keep those only.
   if (samples() == 16 * mini_ && vacf_.block() == mini_) vacf_.coarsen_blocks(4);
 }
@@ -182,6 +225,7 @@ void DiffusionAccumulator::serialize(Archive& a) {
   msd_.serialize(a);
   if (x_) msd_x_.serialize(a);
   coarse_.serialize(a);
+  for (Interval& iv : intervals_) iv.c.serialize(a);
 }
 
 DiffusionReport DiffusionAccumulator::report() const {
@@ -219,11 +263,8 @@ DiffusionReport DiffusionAccumulator::report() const {
         fmt::format("the MSD is not diffusive in the fit window (log-log slope {:.3f}, 1 expected)",
                     r.fit.loglog_slope));
 
-  // Error blocks: four quarters each, fewer when that leaves fewer than four blocks.
-  const long quarters = r.samples / mini_;
-  const long per_block = quarters >= 16 ? 4 : std::max(1L, quarters / 4);
-  const long block_samples = per_block * mini_;
-  const long nb = std::max(1L, r.samples / block_samples);
+  const ErrorBlocks eb = error_blocks(r.samples, mini_);
+  const long block_samples = eb.block_samples, nb = eb.blocks;
   r.error_block = static_cast<double>(block_samples) * dt_;
   if (r.error_block < 0.99 * s_.error_block)
     r.warnings.push_back(fmt::format(
@@ -278,6 +319,19 @@ DiffusionReport DiffusionAccumulator::report() const {
       }
       r.vel_bulk = persistence_from(join_blocks(vacf_, vacf_per_block, nb, true), dt_);
     }
+  }
+  for (const Interval& iv : intervals_) {
+    DiffusionReport::IntervalVelocity out;
+    out.sample_strain = static_cast<double>(1L << iv.level) * dt_;
+    out.interval = static_cast<double>(iv.k) * out.sample_strain;
+    if (iv.c.samples() < 4) {
+      r.warnings.push_back(fmt::format("no velocity over {:g}: fewer than 4 samples", out.interval));
+      continue;
+    }
+    const ErrorBlocks b = error_blocks(iv.c.samples(), iv.mini);
+    out.vel = persistence_from(join_blocks(iv.c, b.block_samples / iv.c.block(), b.blocks, false),
+                               out.sample_strain);
+    r.intervals.push_back(out);
   }
   if (x_) {
     r.has_x = true;
@@ -353,6 +407,20 @@ void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
   if (r.has_x) {
     js["D_x"] = number_or_null(r.fit_x.d);
     js["msd_x_window_slope"] = number_or_null(r.fit_x.loglog_slope);
+  }
+  if (!r.intervals.empty()) {
+    auto& v = js["velocity_intervals"] = nlohmann::json::array();
+    auto& dv = js["dv_intervals"] = nlohmann::json::array();
+    auto& dv_err = js["dv_intervals_err"] = nlohmann::json::array();
+    auto& psi = js["psi_intervals"] = nlohmann::json::array();
+    auto& psi_err = js["psi_intervals_err"] = nlohmann::json::array();
+    for (const auto& iv : r.intervals) {
+      v.push_back(iv.interval);
+      dv.push_back(iv.vel.dv);
+      dv_err.push_back(number_or_null(iv.vel.dv_err));
+      psi.push_back(iv.vel.p.psi);
+      psi_err.push_back(number_or_null(iv.vel.psi_err));
+    }
   }
   js["analysis_samples"] = r.samples;
   js["analysis_sample_strain"] = r.sample_strain;

@@ -24,6 +24,7 @@ DiffusionSettings diffusion_settings(const Config& cfg) {
   s.vacf_max_lag = cfg.analysis.vacf_max_lag;
   s.error_block = cfg.analysis.error_block;
   s.coarse_strain = cfg.analysis.coarse_strain;
+  s.velocity_intervals = cfg.analysis.velocity_intervals;
   return s;
 }
 

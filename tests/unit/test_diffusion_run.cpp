@@ -28,6 +28,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   // The samples are the frames, so that analyse can see them again.
   c.analysis.sample_strain = 0.01;
   c.analysis.coarse_strain = 0.01;
+  c.analysis.velocity_intervals = {0.03};
   c.analysis.msd_window_lo = 0.2;
   c.analysis.msd_window_hi = 0.5;
   c.analysis.vacf_max_lag = 0.3;
@@ -42,7 +43,8 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   const nlohmann::json& after = re.summary;
   for (const char* key :
        {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
-        "msd_window_slope", "analysis_samples", "diffusion_consistency"})
+        "msd_window_slope", "analysis_samples", "diffusion_consistency", "velocity_intervals",
+        "dv_intervals", "psi_intervals"})
     EXPECT_EQ(during[key], after[key]) << key;
   // Physical sanity of the numbers themselves: a sheared suspension diffuses and fluctuates.
   EXPECT_GT(during["D"].get<double>(), 0.0);
@@ -51,6 +53,10 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   // Frames are written at the first step past each multiple of 0.01, so the one at 0.3 lies just
   // past the transient: 0.30, 0.31, ..., 1.50.
   EXPECT_EQ(during["analysis_samples"].get<long>(), 121);
+  // The velocity over 0.03 strain (a seventh of Psi here: close to the instantaneous one).
+  EXPECT_EQ(during["velocity_intervals"][0].get<double>(), 0.03);
+  EXPECT_NEAR(during["dv_intervals"][0].get<double>(), during["dv"].get<double>(),
+              0.1 * during["dv"].get<double>());
   // The x displacement relative to the imposed flow was sampled too (analyse cannot: frames
   // do not integrate it), and its MSD is positive.
   EXPECT_GT(during["D_x"].get<double>(), 0.0);

@@ -232,3 +232,37 @@ TEST(DiffusionAccumulator, CheckpointSizeStaysSmallAtNThousand) {
   std::printf("accumulator at N = 1000, J = 1e-4: %.2f MB after 30 strains, %.1f kB per strain\n",
               at30 / 1e6, per_strain_growth / 1e3);
 }
+
+// The displacement velocity u = (y(t) - y(t - Delta)) / Delta, sampled on the MSD's grid: dv and
+// Psi equal those of the frame functions on the same u, and Delta is rounded to that grid
+// (k 2^l samples, k <= 15). Longer intervals average the velocity: dv falls with Delta while
+// dv^2 Psi (the diffusivity the VACF carries) stays close.
+TEST(DiffusionAccumulator, DisplacementVelocitiesEqualTheFrameAnalysis) {
+  const Walks w = walks(4000, 20, 12.0, 7);
+  sd::DiffusionSettings s;
+  s.window_lo = 100, s.window_hi = 300, s.vacf_max_lag = 120, s.error_block = 400;
+  s.coarse_strain = 10;
+  s.velocity_intervals = {3.0, 40.0, 44.0};  // 3 samples; 40 = 10 x 4; 44 -> 11 x 4
+  const sd::DiffusionReport r = sd::analyse_diffusion(w.y, w.v, 1.0, s);
+  ASSERT_EQ(r.intervals.size(), 3u);
+  EXPECT_EQ(r.intervals[0].interval, 3.0);
+  EXPECT_EQ(r.intervals[1].interval, 40.0);
+  EXPECT_EQ(r.intervals[2].interval, 44.0);
+  for (const auto& iv : r.intervals) {
+    const long stride = std::lround(iv.sample_strain), k = std::lround(iv.interval) / stride;
+    const Eigen::MatrixXd y = every(w.y, stride);
+    const Eigen::MatrixXd u = (y.bottomRows(y.rows() - k) - y.topRows(y.rows() - k)) / iv.interval;
+    const long lag = std::lround(std::ceil(120.0 / iv.sample_strain));
+    // The same lags the grid has, from the every-origin VACF of u.
+    const auto c = sd::velocity_autocorrelation(u, iv.sample_strain, std::min(lag, 15L));
+    EXPECT_NEAR(iv.vel.dv, std::sqrt(c.c[0]), kRel * std::sqrt(c.c[0]));
+    for (std::size_t j = 0; j < 16 && j < iv.vel.c.c.size(); ++j)
+      EXPECT_NEAR(iv.vel.c.c[j], c.c[j], kRel * c.c[0]) << "lag " << j;
+    EXPECT_TRUE(std::isfinite(iv.vel.psi_err));
+  }
+  EXPECT_LT(r.intervals[1].vel.dv, r.dv);
+  EXPECT_LT(r.intervals[2].vel.dv, r.intervals[1].vel.dv);
+  const double d_inst = r.dv * r.dv * r.persistence.psi;
+  const double d_40 = std::pow(r.intervals[1].vel.dv, 2) * r.intervals[1].vel.p.psi;
+  EXPECT_NEAR(d_40, d_inst, 0.15 * d_inst);
+}

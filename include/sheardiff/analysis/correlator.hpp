@@ -49,6 +49,11 @@ class MultipleTauCorrelator {
   // are known, the finer ones need not be kept.
   void coarsen_blocks(long factor);
 
+  // The stored sample `age` samples before the latest one, if the grid keeps it (ages 0 ..
+  // points-1, and k 2^l for k = points/2 .. points-1 when the latest index is a multiple of
+  // 2^l); else nullptr.
+  const double* past(long age) const;
+
   void serialize(Archive& a);
 
  private:

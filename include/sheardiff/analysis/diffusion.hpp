@@ -16,6 +16,7 @@ struct DiffusionSettings {
   double window_lo = 8.0, window_hi = 15.0;  // MSD fit window, strain
   double vacf_max_lag = 2.0;                 // strain; Psi gammadot <= ~0.2 for J <= 0.1
   double error_block = 3.0;                  // strain: time blocks of the error bars
+  std::vector<double> velocity_intervals;    // strain: displacement velocities also reported
   double coarse_strain = 0.2;                // strain: spacing of the samples D comes from
                                              // (config: min(0.2, window_hi / 75))
 };
@@ -44,6 +45,13 @@ struct DiffusionReport {
   bool has_x = false;
   MsdResult msd_x;
   DiffusionFit fit_x;
+  // dv and Psi of the displacement velocity (y(t + Delta) - y(t)) / Delta, per interval.
+  struct IntervalVelocity {
+    double interval = 0.0;      // Delta, strain, as rounded to the grid
+    double sample_strain = 0.0; // spacing of its samples
+    PersistenceEstimate vel;
+  };
+  std::vector<IntervalVelocity> intervals;
   double error_block = 0.0;   // strain, as used
   double step_length = 0.0;   // dv Psi
   double consistency = 0.0;   // D / (dv^2 Psi), 1 if the VACF integral carries the diffusion
@@ -78,12 +86,22 @@ class DiffusionAccumulator {
   void serialize(Archive& a);
 
  private:
+  // A displacement velocity over k 2^level samples, taken every 2^level samples from the MSD
+  // correlator's stored past (so it needs no history of its own).
+  struct Interval {
+    int level = 0;
+    long k = 1, mini = 1;
+    MultipleTauCorrelator c;
+  };
+
   DiffusionSettings s_;
   double dt_ = 0.0;
   long particles_ = 0, mini_ = 1, stride_ = 1;
   bool bulk_ = false, x_ = false;
   MultipleTauCorrelator vacf_, msd_, msd_x_;
   IncrementGram coarse_;
+  std::vector<Interval> intervals_;
+  std::vector<double> u_;  // scratch
 };
 
 // The same analysis of frames uniformly spaced by frame_strain (frames x particles), fed to a
