@@ -24,7 +24,19 @@ std::string value_text(const toml::node& v, const std::string& where) {
   if (auto d = v.as_floating_point()) return fmt::format("{}", d->get());
   if (auto b = v.as_boolean()) return b->get() ? "true" : "false";
   if (auto s = v.as_string()) return fmt::format("\"{}\"", s->get());
-  throw ConfigError(fmt::format("{}: must be a number, a boolean or a string", where));
+  // A list key (analysis.velocity_intervals): its numbers, as --set reads a TOML array.
+  if (auto a = v.as_array()) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node& x = *a->get(i);
+      if (!x.is_number())
+        throw ConfigError(fmt::format("{}: a list may only hold numbers", where));
+      out += (i ? ", " : "") + value_text(x, where);
+    }
+    return out + "]";
+  }
+  throw ConfigError(
+      fmt::format("{}: must be a number, a boolean, a string or a list of numbers", where));
 }
 
 // The value as it appears in a directory name: no quotes, nothing a path cannot hold.

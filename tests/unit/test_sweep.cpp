@@ -65,6 +65,29 @@ base = "base.toml"
   EXPECT_GT(points[11].cost, points[0].cost);
 }
 
+// A list key (analysis.velocity_intervals) set for every point reaches each point's config.
+TEST(Sweep, ListValuesAreSetAsLists) {
+  const auto file = write_files("list", R"(
+[sweep]
+base = "base.toml"
+[sweep.set]
+"analysis.velocity_intervals" = [0.0035, 0.01]
+[sweep.axes]
+"flow.J" = [0.1]
+)");
+  const auto spec = load_sweep(file);
+  const auto points = expand_points(spec);
+  ASSERT_EQ(points.size(), 1u);
+  EXPECT_EQ(points[0].overrides[0], "analysis.velocity_intervals=[0.0035, 0.01]");
+  const Config cfg = load_config(spec.base, points[0].overrides);
+  EXPECT_EQ(cfg.analysis.velocity_intervals, (std::vector<double>{0.0035, 0.01}));
+  EXPECT_NE(error_of(write_files("list_bad", "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
+                                             "\"analysis.velocity_intervals\" = [\"a\"]\n"
+                                             "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
+                .find("a list may only hold numbers"),
+            std::string::npos);
+}
+
 TEST(Sweep, BadSweepFilesNameTheKey) {
   EXPECT_NE(error_of(write_files("unknown",
                                  "[sweep]\nbase = \"base.toml\"\nbsae = 1\n"
