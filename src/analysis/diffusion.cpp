@@ -32,8 +32,11 @@ Eigen::MatrixXd bulk_mask(const Eigen::MatrixXd& y, const Eigen::VectorXd& botto
 
 namespace {
 
-// What the correlator's sums give once its quarter-blocks of origins are joined into `nb`
-// error blocks of `per_block` quarters (the last one takes the remainder): the correlation over
+// Origins are summed per 1/kParts of an error block until the window's length decides the blocks.
+constexpr long kParts = 16;
+
+// What the correlator's sums give once its parts of blocks of origins are joined into `nb`
+// error blocks of `per_block` parts (the last one takes the remainder): the correlation over
 // every origin and one with each block left out.
 struct JoinedSums {
   std::vector<long> lag;                 // samples, lags that have pairs
@@ -132,14 +135,15 @@ MsdResult msd_from(const JoinedSums& j, double dt, double particles) {
   return m;
 }
 
-// Error blocks over `samples` samples whose origins were summed per `mini` (a quarter of
-// analysis.error_block): four quarters each, fewer when that leaves fewer than four blocks.
+// Error blocks over `samples` samples whose origins were summed per `mini` samples
+// (analysis.error_block / kParts): kParts parts each, fewer when that leaves fewer than four
+// blocks, so that a window down to a quarter of an error block still gets four.
 struct ErrorBlocks {
   long block_samples = 1, blocks = 1;
 };
 ErrorBlocks error_blocks(long samples, long mini) {
-  const long quarters = samples / mini;
-  const long per_block = quarters >= 16 ? 4 : std::max(1L, quarters / 4);
+  const long parts = samples / mini;
+  const long per_block = parts >= 4 * kParts ? kParts : std::max(1L, parts / 4);
   ErrorBlocks b;
   b.block_samples = per_block * mini;
   b.blocks = std::max(1L, samples / b.block_samples);
@@ -158,9 +162,9 @@ DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sa
         "block {}, window [{}, {}], VACF lag {}",
         sample_strain, particles, s.coarse_strain, s.error_block, s.window_lo, s.window_hi,
         s.vacf_max_lag));
-  // Origins are summed per quarter of an error block: a window too short for four whole
+  // Origins are summed per part of an error block: a window too short for four whole
   // blocks still gets four shorter ones.
-  mini_ = std::max(1L, std::lround(0.25 * s.error_block / dt_));
+  mini_ = std::max(1L, std::lround(s.error_block / kParts / dt_));
   stride_ = std::max(1L, std::lround(s.coarse_strain / dt_));
   const double dtc = static_cast<double>(stride_) * dt_;
   const long vacf_lag = std::max(1L, static_cast<long>(std::ceil(s.vacf_max_lag / dt_ - 1e-9)));
@@ -187,7 +191,7 @@ DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sa
           "msd_window_hi = {:g})",
           delta, s.window_hi));
     const double spacing = static_cast<double>(1L << iv.level) * dt_;
-    iv.mini = std::max(1L, std::lround(0.25 * s.error_block / spacing));
+    iv.mini = std::max(1L, std::lround(s.error_block / kParts / spacing));
     const long lag = std::max(1L, static_cast<long>(std::ceil(s.vacf_max_lag / spacing - 1e-9)));
     iv.c = MultipleTauCorrelator(K::product, particles, lag, iv.mini, false);
     intervals_.push_back(std::move(iv));
@@ -213,10 +217,11 @@ void DiffusionAccumulator::add(const double* y, const double* vy, const double* 
     for (long i = 0; i < particles_; ++i)
       u_[static_cast<std::size_t>(i)] = (y[i] - before[i]) / delta;
     iv.c.add(u_.data());
-    if (iv.c.samples() == 16 * iv.mini && iv.c.block() == iv.mini) iv.c.coarsen_blocks(4);
+    if (iv.c.samples() == 4 * kParts * iv.mini && iv.c.block() == iv.mini)
+      iv.c.coarsen_blocks(kParts);
   }
-  // From 16 quarters on, blocks are whole error blocks (report()): keep those only.
-  if (samples() == 16 * mini_ && vacf_.block() == mini_) vacf_.coarsen_blocks(4);
+  // From 4 kParts parts on, blocks are whole error blocks (report()): keep those only.
+  if (samples() == 4 * kParts * mini_ && vacf_.block() == mini_) vacf_.coarsen_blocks(kParts);
 }
 
 void DiffusionAccumulator::serialize(Archive& a) {

@@ -179,7 +179,7 @@ TEST(DiffusionAccumulator, PersistenceEqualsTheFrameJackknife) {
   s.window_lo = 100, s.window_hi = 200, s.vacf_max_lag = 12, s.error_block = 400;
   s.coarse_strain = 10;
   const sd::DiffusionReport r = sd::analyse_diffusion(w.y, w.v, 1.0, s);
-  // error_block 400 samples in quarters of 100: 20 quarters, blocks of 4 quarters.
+  // error_block 400 samples in parts of 25: 80 parts, blocks of 16 parts.
   const auto ref = sd::persistence_with_errors(w.v, 1.0, 12, 400);
   EXPECT_EQ(r.vel.blocks, ref.blocks);
   EXPECT_NEAR(r.dv, ref.dv, kRel * ref.dv);

@@ -64,7 +64,7 @@ struct DiffusionReport {
 // The diffusion analysis accumulated sample by sample while the run goes, so that neither the
 // trajectory nor the checkpoint has to hold the measured window (docs/model.md section 9):
 // - the VACF of v_y and the MSD of y (and of the non-affine x displacement) on a multiple-tau
-//   grid (MultipleTauCorrelator), every sample an origin, sums kept per quarter error block;
+//   grid (MultipleTauCorrelator), every sample an origin, sums kept per sixteenth of an error block;
 // - the every-origin MSD and the increment products of y on samples coarse_strain apart
 //   (IncrementGram): D and its error bar (msd_slope_error).
 // Memory is that of ~100 samples per signal (independent of the window's length) plus a few
