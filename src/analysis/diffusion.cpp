@@ -74,55 +74,8 @@ std::vector<double> lag_strains(const std::vector<long>& lag, double dt) {
   return t;
 }
 
-double jackknife(const std::vector<double>& x) {
-  const auto n = static_cast<double>(x.size());
-  if (x.size() < 2) return std::nan("");
-  double mean = 0;
-  for (double v : x) {
-    if (!std::isfinite(v)) return std::nan("");
-    mean += v / n;
-  }
-  double s = 0;
-  for (double v : x) s += (v - mean) * (v - mean);
-  return std::sqrt((n - 1.0) / n * s);
-}
-
-// dv, Psi (every definition) and their delete-one-block jackknife errors, as
-// persistence_with_errors computes them from frames.
 PersistenceEstimate persistence_from(const JoinedSums& j, double dt) {
-  const auto correlation = [&](const Eigen::RowVectorXd& num, const Eigen::RowVectorXd& den) {
-    Autocorrelation c;
-    c.lag = lag_strains(j.lag, dt);
-    for (Eigen::Index k = 0; k < num.size(); ++k) c.c.push_back(den(k) > 0 ? num(k) / den(k) : 0.0);
-    return c;
-  };
-  PersistenceEstimate out;
-  out.blocks = j.block_sum.rows();
-  out.c = correlation(j.sum, j.count);
-  out.p = persistence_time(out.c);
-  out.dv = std::sqrt(out.p.c0);
-  const double nan = std::nan("");
-  out.dv_err = out.psi_err = out.psi_e_err = out.psi_zero_err = out.psi_full_err = nan;
-  if (out.blocks < 2) return out;
-  std::vector<double> dv, psi, psi_e, psi_zero, psi_full;
-  for (Eigen::Index B = 0; B < out.blocks; ++B) {
-    const Autocorrelation c =
-        correlation(j.sum - j.block_sum.row(B), j.count - j.block_count.row(B));
-    if (!(c.c[0] > 0.0)) {
-      for (auto* v : {&dv, &psi, &psi_e, &psi_zero, &psi_full}) v->push_back(nan);
-      continue;
-    }
-    const Persistence p = persistence_time(c);
-    dv.push_back(std::sqrt(p.c0));
-    psi.push_back(p.psi), psi_e.push_back(p.psi_e), psi_zero.push_back(p.psi_zero);
-    psi_full.push_back(p.psi_full);
-  }
-  out.dv_err = jackknife(dv);
-  out.psi_err = jackknife(psi);
-  out.psi_e_err = jackknife(psi_e);
-  out.psi_zero_err = jackknife(psi_zero);
-  out.psi_full_err = jackknife(psi_full);
-  return out;
+  return persistence_from_block_sums(lag_strains(j.lag, dt), j.block_sum, j.block_count);
 }
 
 MsdResult msd_from(const JoinedSums& j, double dt, double particles) {

@@ -12,7 +12,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Delete-one jackknife standard error of leave-one-out values x (NaN if any is not finite).
+}  // namespace
+
 double jackknife_err(const std::vector<double>& x) {
   const auto n = static_cast<double>(x.size());
   if (x.size() < 2) return kNaN;
@@ -26,7 +27,6 @@ double jackknife_err(const std::vector<double>& x) {
   return std::sqrt((n - 1.0) / n * s);
 }
 
-}  // namespace
 
 BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& x, double t_from,
                        double t_to, long blocks) {
@@ -268,9 +268,7 @@ PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt,
         v.cols(), max_lag, block_frames));
   if (mask && (mask->rows() != v.rows() || mask->cols() != v.cols()))
     throw std::invalid_argument("persistence_with_errors: mask shape differs from v");
-  PersistenceEstimate out;
   const long nb = std::max(1L, frames / block_frames);
-  out.blocks = nb;
   // Frames as contiguous columns: each (origin, lag) term is one dot product over particles.
   const Eigen::MatrixXd vt = v.transpose();
   Eigen::MatrixXd origin = vt;
@@ -286,28 +284,34 @@ PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt,
       cnt(B, k) += weight;
     }
   }
-  const Eigen::RowVectorXd s_all = s.colwise().sum(), n_all = cnt.colwise().sum();
+  std::vector<double> lag;
+  for (long k = 0; k <= max_lag; ++k) lag.push_back(static_cast<double>(k) * dt);
+  return persistence_from_block_sums(lag, s, cnt);
+}
+
+PersistenceEstimate persistence_from_block_sums(const std::vector<double>& lag,
+                                                const Eigen::MatrixXd& block_sum,
+                                                const Eigen::MatrixXd& block_count) {
+  const Eigen::RowVectorXd s_all = block_sum.colwise().sum();
+  const Eigen::RowVectorXd n_all = block_count.colwise().sum();
   const auto correlation = [&](const Eigen::RowVectorXd& num, const Eigen::RowVectorXd& den) {
     Autocorrelation c;
-    for (long k = 0; k <= max_lag; ++k) {
-      c.lag.push_back(static_cast<double>(k) * dt);
-      c.c.push_back(den(k) > 0 ? num(k) / den(k) : 0.0);
-    }
+    c.lag = lag;
+    for (Eigen::Index k = 0; k < num.size(); ++k) c.c.push_back(den(k) > 0 ? num(k) / den(k) : 0.0);
     return c;
   };
+  PersistenceEstimate out;
+  out.blocks = block_sum.rows();
   out.c = correlation(s_all, n_all);
   out.p = persistence_time(out.c);
   out.dv = std::sqrt(out.p.c0);
-  if (nb < 2) {
-    out.dv_err = out.psi_err = out.psi_e_err = out.psi_zero_err = out.psi_full_err = kNaN;
-    return out;
-  }
+  out.dv_err = out.psi_err = out.psi_e_err = out.psi_zero_err = out.psi_full_err = kNaN;
+  if (out.blocks < 2) return out;
   std::vector<double> dv, psi, psi_e, psi_zero, psi_full;
-  for (long B = 0; B < nb; ++B) {
-    const Autocorrelation c = correlation(s_all - s.row(B), n_all - cnt.row(B));
+  for (Eigen::Index B = 0; B < out.blocks; ++B) {
+    const Autocorrelation c = correlation(s_all - block_sum.row(B), n_all - block_count.row(B));
     if (!(c.c[0] > 0.0)) {
-      dv.push_back(kNaN), psi.push_back(kNaN), psi_e.push_back(kNaN);
-      psi_zero.push_back(kNaN), psi_full.push_back(kNaN);
+      for (auto* x : {&dv, &psi, &psi_e, &psi_zero, &psi_full}) x->push_back(kNaN);
       continue;
     }
     const Persistence p = persistence_time(c);

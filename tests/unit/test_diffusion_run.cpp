@@ -16,7 +16,9 @@ namespace {
 
 std::string file_text(const std::filesystem::path& f);
 
-TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
+// 60 particles in simple shear at J = 0.1 for 1.5 strains, frames (and the coarse MSD grid)
+// every frame_strain, the MSD window [0.2, 0.5] and VACF lags to 0.3 strain.
+Config sheared_60(double frame_strain) {
   Config c;
   c.particles.n = 60;
   c.particles.phi_init = 0.7;
@@ -24,14 +26,19 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   c.contact.ktilde = 1e3;
   c.run.strain = 1.5;
   c.run.transient_strain = 0.3;
-  c.output.frame_strain = 0.01;
-  // The samples are the frames, so that analyse can see them again.
-  c.analysis.sample_strain = 0.01;
-  c.analysis.coarse_strain = 0.01;
-  c.analysis.velocity_intervals = {0.03};
+  c.output.frame_strain = frame_strain;
+  c.analysis.coarse_strain = frame_strain;
   c.analysis.msd_window_lo = 0.2;
   c.analysis.msd_window_hi = 0.5;
   c.analysis.vacf_max_lag = 0.3;
+  return c;
+}
+
+TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
+  Config c = sheared_60(0.01);
+  // The samples are the frames, so that analyse can see them again.
+  c.analysis.sample_strain = 0.01;
+  c.analysis.velocity_intervals = {0.03};
   const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_diffusion_run";
   std::filesystem::remove_all(dir);
   const nlohmann::json during = run_to_directory(c, dir, false);
@@ -80,18 +87,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
 // re-analysed to the same numbers from its trajectory: analyse recomputes from the frames into
 // DIR/reanalysis/, naming the keys that differ, and leaves the run's files alone.
 TEST(DiffusionRun, FinerSamplesThanFramesAnalyseBeside) {
-  Config c;
-  c.particles.n = 60;
-  c.particles.phi_init = 0.7;
-  c.flow.j = 1e-1;
-  c.contact.ktilde = 1e3;
-  c.run.strain = 1.5;
-  c.run.transient_strain = 0.3;
-  c.output.frame_strain = 0.02;
-  c.analysis.coarse_strain = 0.02;
-  c.analysis.msd_window_lo = 0.2;
-  c.analysis.msd_window_hi = 0.5;
-  c.analysis.vacf_max_lag = 0.3;
+  const Config c = sheared_60(0.02);
   const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_finer_samples";
   std::filesystem::remove_all(dir);
   const nlohmann::json during = run_to_directory(c, dir, false);

@@ -90,6 +90,15 @@ struct PersistenceEstimate {
 PersistenceEstimate persistence_with_errors(const Eigen::MatrixXd& v, double dt, long max_lag,
                                             long block_frames,
                                             const Eigen::MatrixXd* mask = nullptr);
+// The same from sums already split by block: block_sum(B, k) and block_count(B, k) are block B's
+// sum of v(t) v(t + lag[k]) and its weight. Both the frame analysis and the streaming
+// correlator end here, so their dv, Psi and errors agree by construction.
+PersistenceEstimate persistence_from_block_sums(const std::vector<double>& lag,
+                                                const Eigen::MatrixXd& block_sum,
+                                                const Eigen::MatrixXd& block_count);
+// Delete-one jackknife standard error of leave-one-out values x (NaN if fewer than two or any
+// is not finite).
+double jackknife_err(const std::vector<double>& x);
 
 // MSD over the given reference frames counting particle i at origin t0 only where
 // mask(t0, i) != 0 (the bulk-only MSD); the unmasked overload is in time_series.hpp.
