@@ -132,192 +132,244 @@ std::string oversubscription_warning(int jobs, int threads_per_job, int cores) {
       jobs, threads_per_job, static_cast<long>(jobs) * threads_per_job, cores, fit);
 }
 
-int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
-              bool progress_lines) {
-  const auto points = expand_points(spec);
-  fs::create_directories(out_dir / "points");
-  fs::create_directories(out_dir / "logs");
-  const FileLock lock(out_dir / "sweep.lock", "the sweep in " + out_dir.string());
-  if (const std::string w = oversubscription_warning(jobs, threads_per_worker(), usable_cores());
-      !w.empty())
-    fmt::print(stderr, "{}\n", w);
+namespace {
 
-  // States first (a foreign directory stops the sweep before anything starts), longest first.
-  std::vector<const SweepPoint*> todo, elsewhere;
-  long finished_before = 0;
-  std::error_code ec;
-  for (const auto& p : points) {
-    if (point_state(spec, p, out_dir) == PointState::finished) {
-      ++finished_before;
-      // A failure recorded by an earlier attempt no longer describes the point.
-      fs::remove(out_dir / "logs" / (p.name + ".failed"), ec);
-    } else if (locked_elsewhere(point_lock(out_dir, p))) {
-      elsewhere.push_back(&p);
+// SIGCHLD, SIGINT and SIGTERM blocked for the pool's lifetime: they are taken synchronously
+// (sigtimedwait), so no handler and no global flag. Restored on every exit path.
+class BlockedSignals {
+ public:
+  BlockedSignals() {
+    sigemptyset(&set_);
+    sigaddset(&set_, SIGCHLD);
+    sigaddset(&set_, SIGINT);
+    sigaddset(&set_, SIGTERM);
+    sigprocmask(SIG_BLOCK, &set_, &old_);
+  }
+  ~BlockedSignals() { sigprocmask(SIG_SETMASK, &old_, nullptr); }
+  BlockedSignals(const BlockedSignals&) = delete;
+  BlockedSignals& operator=(const BlockedSignals&) = delete;
+  // The next of them within `seconds`, or -1.
+  int wait(long seconds) const {
+    const timespec t{seconds, 0};
+    return sigtimedwait(&set_, nullptr, &t);
+  }
+
+ private:
+  sigset_t set_{}, old_{};
+};
+
+// The pool of one `sweep` command: points to run (longest first), points that workers of an
+// earlier pool still run, the workers it started, and what it has counted.
+class WorkerPool {
+ public:
+  WorkerPool(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
+             bool progress_lines)
+      : spec_(spec), out_dir_(out_dir), jobs_(jobs), exe_(exe), progress_lines_(progress_lines),
+        points_(expand_points(spec)) {}
+
+  int run();
+
+ private:
+  void sort_points();
+  void spawn(const SweepPoint* p);
+  void reap();
+  void progress();
+  void poll_elsewhere();
+  void forget_failure(const SweepPoint& p) {
+    std::error_code ec;
+    fs::remove(out_dir_ / "logs" / (p.name + ".failed"), ec);
+  }
+  // Off a terminal (a batch log), the pool's lines start with an ISO 8601 UTC timestamp.
+  std::string stamp() const { return tty_ ? std::string() : iso8601_utc_now() + "  "; }
+
+  const SweepSpec& spec_;
+  const fs::path out_dir_;
+  const int jobs_;
+  const fs::path exe_;
+  const bool progress_lines_;
+  const std::vector<SweepPoint> points_;
+  const bool tty_ = isatty(STDERR_FILENO) != 0;
+  std::vector<const SweepPoint*> todo_, elsewhere_;
+  std::map<pid_t, Worker> running_;
+  long finished_before_ = 0, done_ = 0, failed_ = 0;
+  double done_cost_ = 0, done_seconds_ = 0;
+  const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point last_print_ = t0_ - std::chrono::hours(1);
+  bool changed_ = true;
+  int stop_signal_ = 0;
+};
+
+// States first (a foreign directory stops the sweep before anything starts), longest first.
+void WorkerPool::sort_points() {
+  for (const auto& p : points_) {
+    if (point_state(spec_, p, out_dir_) == PointState::finished) {
+      ++finished_before_;
+      forget_failure(p);  // a failure recorded by an earlier attempt no longer describes it
+    } else if (locked_elsewhere(point_lock(out_dir_, p))) {
+      elsewhere_.push_back(&p);
     } else {
-      todo.push_back(&p);
+      todo_.push_back(&p);
     }
   }
   // Workers of an earlier pool that was killed (SIGKILL, a lost terminal) still run their
   // points: they are waited for, not started twice nor counted as failed.
-  if (!elsewhere.empty())
+  if (!elsewhere_.empty())
     fmt::print(stderr,
                "sweep: {} point(s) are being run by other processes (the workers of an earlier "
                "sweep whose pool was stopped?): waiting for them, not starting them again\n",
-               elsewhere.size());
-  std::stable_sort(todo.begin(), todo.end(),
+               elsewhere_.size());
+  std::stable_sort(todo_.begin(), todo_.end(),
                    [](const SweepPoint* a, const SweepPoint* b) { return a->cost > b->cost; });
-  std::reverse(todo.begin(), todo.end());  // taken from the back
+  std::reverse(todo_.begin(), todo_.end());  // taken from the back
+}
 
-  // Signals are taken synchronously (sigtimedwait), so no handler and no global flag: SIGCHLD
-  // says a worker ended, SIGINT/SIGTERM are forwarded to the workers, which checkpoint.
-  sigset_t mask, old_mask;
-  sigemptyset(&mask);
-  sigaddset(&mask, SIGCHLD);
-  sigaddset(&mask, SIGINT);
-  sigaddset(&mask, SIGTERM);
-  sigprocmask(SIG_BLOCK, &mask, &old_mask);
+// A worker is this executable running `sweep FILE --out DIR --point I`, its output appended to
+// the point's log, with no signal blocked (it checkpoints on SIGTERM).
+void WorkerPool::spawn(const SweepPoint* p) {
+  const std::string log = (out_dir_ / "logs" / (p->name + ".log")).string();
+  const std::string index = std::to_string(p->index);
+  const std::string file = spec_.file.string(), out = out_dir_.string(), self = exe_.string();
+  std::vector<char*> argv = {const_cast<char*>(self.c_str()),  const_cast<char*>("sweep"),
+                             const_cast<char*>(file.c_str()),  const_cast<char*>("--out"),
+                             const_cast<char*>(out.c_str()),   const_cast<char*>("--point"),
+                             const_cast<char*>(index.c_str()), nullptr};
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
   sigset_t child_mask;
   sigemptyset(&child_mask);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  posix_spawnattr_setsigmask(&attr, &child_mask);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&attr);
+  if (rc != 0)
+    throw std::runtime_error(fmt::format("sweep: cannot start {}: {}", self, std::strerror(rc)));
+  running_[pid] = {p, std::chrono::steady_clock::now()};
+  changed_ = true;
+}
 
-  // Off a terminal (a batch log), the pool's lines start with an ISO 8601 UTC timestamp.
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  const auto stamp = [tty] { return tty ? std::string() : iso8601_utc_now() + "  "; };
-  std::map<pid_t, Worker> running;
-  long done = 0, failed = 0;
-  double done_cost = 0, done_seconds = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  auto last_print = t0 - std::chrono::hours(1);
-  bool changed = true;
-  int stop_signal = 0;
-
-  const auto spawn = [&](const SweepPoint* p) {
-    const std::string log = (out_dir / "logs" / (p->name + ".log")).string();
-    const std::string index = std::to_string(p->index);
-    const std::string file = spec.file.string(), out = out_dir.string(), self = exe.string();
-    std::vector<char*> argv = {const_cast<char*>(self.c_str()),  const_cast<char*>("sweep"),
-                               const_cast<char*>(file.c_str()),  const_cast<char*>("--out"),
-                               const_cast<char*>(out.c_str()),   const_cast<char*>("--point"),
-                               const_cast<char*>(index.c_str()), nullptr};
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    posix_spawnattr_setsigmask(&attr, &child_mask);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, self.c_str(), &fa, &attr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&fa);
-    posix_spawnattr_destroy(&attr);
-    if (rc != 0)
-      throw std::runtime_error(fmt::format("sweep: cannot start {}: {}", self, std::strerror(rc)));
-    running[pid] = {p, std::chrono::steady_clock::now()};
-  };
-
-  const auto reap = [&] {
-    int status = 0;
-    pid_t pid;
-    while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
-      auto it = running.find(pid);
-      if (it == running.end()) continue;
-      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      const double secs =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.started)
-              .count();
-      const auto& p = *it->second.point;
-      if (code == 0) {
-        ++done;
-        done_cost += p.cost;
-        done_seconds += secs;
-      } else if (!stop_signal && locked_elsewhere(point_lock(out_dir, p))) {
-        // Taken by another process between the check and the start: waited for like the others.
-        elsewhere.push_back(&p);
-      } else if (!stop_signal) {
-        ++failed;
-        fmt::print(stderr, "{}sweep: point {} failed (exit {}) after {}; see {}\n", stamp(), p.name,
-                   code, duration_text(secs), (out_dir / "logs" / (p.name + ".log")).string());
-      }
-      running.erase(it);
-      changed = true;
+void WorkerPool::reap() {
+  int status = 0;
+  pid_t pid;
+  while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+    auto it = running_.find(pid);
+    if (it == running_.end()) continue;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.started)
+            .count();
+    const auto& p = *it->second.point;
+    if (code == 0) {
+      ++done_;
+      done_cost_ += p.cost;
+      done_seconds_ += secs;
+    } else if (!stop_signal_ && locked_elsewhere(point_lock(out_dir_, p))) {
+      // Taken by another process between the check and the start: waited for like the others.
+      elsewhere_.push_back(&p);
+    } else if (!stop_signal_) {
+      ++failed_;
+      fmt::print(stderr, "{}sweep: point {} failed (exit {}) after {}; see {}\n", stamp(), p.name,
+                 code, duration_text(secs), (out_dir_ / "logs" / (p.name + ".log")).string());
     }
-  };
+    running_.erase(it);
+    changed_ = true;
+  }
+}
 
-  const auto progress = [&] {
-    if (!progress_lines) return;
-    const auto now = std::chrono::steady_clock::now();
-    if (!changed && now - last_print < std::chrono::seconds(30)) return;
-    const double elapsed = std::chrono::duration<double>(now - t0).count();
-    // Seconds per unit of cost from the points finished so far; a running point is charged
-    // what its estimate has left (at least a tenth of it: estimates are rough).
-    std::string eta = "?";
-    if (done > 0) {
-      const double rate = done_seconds / done_cost;
-      double left = 0;
-      for (const auto* p : todo) left += p->cost * rate;
-      for (const auto& [pid, w] : running) {
-        const double est = w.point->cost * rate;
-        left += std::max(est - std::chrono::duration<double>(now - w.started).count(), 0.1 * est);
-      }
-      eta = duration_text(left / jobs);
+void WorkerPool::progress() {
+  if (!progress_lines_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (!changed_ && now - last_print_ < std::chrono::seconds(30)) return;
+  const double elapsed = std::chrono::duration<double>(now - t0_).count();
+  // Seconds per unit of cost from the points finished so far; a running point is charged
+  // what its estimate has left (at least a tenth of it: estimates are rough).
+  std::string eta = "?";
+  if (done_ > 0) {
+    const double rate = done_seconds_ / done_cost_;
+    double left = 0;
+    for (const auto* p : todo_) left += p->cost * rate;
+    for (const auto& [pid, w] : running_) {
+      const double est = w.point->cost * rate;
+      left += std::max(est - std::chrono::duration<double>(now - w.started).count(), 0.1 * est);
     }
-    fmt::print(stderr,
-               "{}sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
-               "{} elapsed, ETA {}\n",
-               stamp(), finished_before + done, points.size(), finished_before, failed,
-               running.size() + elsewhere.size(), todo.size(), duration_text(elapsed), eta);
-    last_print = now;
-    changed = false;
-  };
+    eta = duration_text(left / jobs_);
+  }
+  fmt::print(stderr,
+             "{}sweep: {}/{} done ({} before this start, {} failed), {} running, {} to go; "
+             "{} elapsed, ETA {}\n",
+             stamp(), finished_before_ + done_, points_.size(), finished_before_, failed_,
+             running_.size() + elsewhere_.size(), todo_.size(), duration_text(elapsed), eta);
+  last_print_ = now;
+  changed_ = false;
+}
 
-  // A point run elsewhere is checked at each tick: once its lock is free it is finished (done)
-  // or goes back to the queue (it resumes from its checkpoint).
-  const auto poll_elsewhere = [&] {
-    for (auto it = elsewhere.begin(); it != elsewhere.end();) {
-      if (locked_elsewhere(point_lock(out_dir, **it))) {
-        ++it;
-        continue;
-      }
-      if (point_state(spec, **it, out_dir) == PointState::finished) {
-        ++finished_before;
-        fs::remove(out_dir / "logs" / ((*it)->name + ".failed"), ec);
-      } else {
-        todo.insert(todo.begin(), *it);
-      }
-      it = elsewhere.erase(it);
-      changed = true;
+// A point run elsewhere is checked at each tick: once its lock is free it is finished (done)
+// or goes back to the queue (it resumes from its checkpoint).
+void WorkerPool::poll_elsewhere() {
+  for (auto it = elsewhere_.begin(); it != elsewhere_.end();) {
+    if (locked_elsewhere(point_lock(out_dir_, **it))) {
+      ++it;
+      continue;
     }
-  };
+    if (point_state(spec_, **it, out_dir_) == PointState::finished) {
+      ++finished_before_;
+      forget_failure(**it);
+    } else {
+      todo_.insert(todo_.begin(), *it);
+    }
+    it = elsewhere_.erase(it);
+    changed_ = true;
+  }
+}
 
-  while (!todo.empty() || !running.empty() || (!elsewhere.empty() && !stop_signal)) {
+// SIGCHLD says a worker ended; SIGINT/SIGTERM are forwarded to the workers, which checkpoint.
+int WorkerPool::run() {
+  fs::create_directories(out_dir_ / "points");
+  fs::create_directories(out_dir_ / "logs");
+  const FileLock lock(out_dir_ / "sweep.lock", "the sweep in " + out_dir_.string());
+  if (const std::string w = oversubscription_warning(jobs_, threads_per_worker(), usable_cores());
+      !w.empty())
+    fmt::print(stderr, "{}\n", w);
+  sort_points();
+  const BlockedSignals signals;
+  while (!todo_.empty() || !running_.empty() || (!elsewhere_.empty() && !stop_signal_)) {
     poll_elsewhere();
-    while (!stop_signal && static_cast<int>(running.size() + elsewhere.size()) < jobs &&
-           !todo.empty()) {
-      spawn(todo.back());
-      todo.pop_back();
-      changed = true;
+    while (!stop_signal_ && static_cast<int>(running_.size() + elsewhere_.size()) < jobs_ &&
+           !todo_.empty()) {
+      spawn(todo_.back());
+      todo_.pop_back();
     }
     progress();
-    if (stop_signal && running.empty()) break;
-    const timespec wait{2, 0};
-    const int sig = sigtimedwait(&mask, nullptr, &wait);
-    if ((sig == SIGINT || sig == SIGTERM) && !stop_signal) {
-      stop_signal = sig;
+    if (stop_signal_ && running_.empty()) break;
+    const int sig = signals.wait(2);
+    if ((sig == SIGINT || sig == SIGTERM) && !stop_signal_) {
+      stop_signal_ = sig;
       fmt::print(stderr, "{}sweep: signal {}: stopping {} running point(s) at their checkpoint\n",
-                 stamp(), sig, running.size());
-      for (const auto& [pid, w] : running) kill(pid, SIGTERM);
+                 stamp(), sig, running_.size());
+      for (const auto& [pid, w] : running_) kill(pid, SIGTERM);
     }
     reap();
-    if (stop_signal && running.empty()) break;
+    if (stop_signal_ && running_.empty()) break;
   }
-  if (!stop_signal) progress();  // the last line: every point done, when
-  sigprocmask(SIG_SETMASK, &old_mask, nullptr);
-  if (stop_signal)
-    throw RunInterrupted(stop_signal,
+  if (stop_signal_)
+    throw RunInterrupted(stop_signal_,
                          fmt::format("sweep stopped by signal {}: run the same command again to "
                                      "continue (finished points are kept, the others resume)",
-                                     stop_signal));
-  return static_cast<int>(failed);
+                                     stop_signal_));
+  progress();  // the last line: every point done, when
+  return static_cast<int>(failed_);
+}
+
+}  // namespace
+
+int run_local(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
+              bool progress_lines) {
+  return WorkerPool(spec, out_dir, jobs, exe, progress_lines).run();
 }
 
 }  // namespace sheardiff
