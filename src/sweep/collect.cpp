@@ -339,6 +339,200 @@ json fits_of_group(const std::map<double, std::vector<json>>& by_j, const json& 
 
 }  // namespace
 
+namespace {
+
+using Row = std::map<std::string, json>;
+
+// What a collection gathers: sweep.csv's rows and columns, and the finished measurements grouped
+// by the axes other than J and the seeds (within a group, by J).
+struct Collection {
+  std::vector<Row> table;
+  std::set<std::string> summary_keys, kept_axes;
+  std::map<std::string, std::map<double, std::vector<json>>> groups;
+  std::map<std::string, json> group_axes;
+  long finished = 0, kept = 0;
+
+  // The summary's keys into the row; a measurement that passed its window's test into its group.
+  void add_summary(Row& row, const json& summary, const std::string& group_key, const json& axes,
+                   bool placed) {
+    std::map<std::string, json> flat;
+    flatten(summary, flat);
+    for (auto& [k, v] : flat) summary_keys.insert(k), row[k] = v;
+    const std::string verdict = window_verdict(summary);
+    if (!verdict.empty()) row["status"] = verdict;
+    if (placed && verdict.empty() && summary.contains("J")) {
+      groups[group_key][summary["J"].get<double>()].push_back(summary);
+      group_axes[group_key] = axes;
+    } else if (placed) {
+      group_axes[group_key] = axes;
+    }
+  }
+};
+
+struct PointResult {
+  std::string status = "missing";
+  json summary;
+};
+
+// A finished run directory is stored first; a point finished elsewhere is read from the store.
+// A finished point whose config differs from the sweep's is an error, not a row.
+PointResult point_result(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir) {
+  PointResult r;
+  auto dir = point_dir(out_dir, p);
+  const bool here =
+      fs::exists(dir / "summary.json") && point_state(spec, p, out_dir) == PointState::finished;
+  if (here) export_point(spec, p, out_dir);
+  if (!here)
+    if (const auto stored = stored_point(spec, p); !stored.empty()) dir = stored;
+  if (fs::exists(dir / "summary.json")) {
+    if (here || dir != point_dir(out_dir, p)) {
+      std::ifstream in(dir / "summary.json");
+      r.summary = json::parse(in);
+      r.status = "done";
+    }
+  } else if (fs::exists(out_dir / "logs" / (p.name + ".failed"))) {
+    std::ifstream in(out_dir / "logs" / (p.name + ".failed"));
+    std::string why;
+    std::getline(in, why);
+    r.status = "failed: " + why;
+  } else if (fs::exists(dir / "checkpoint.bin")) {
+    r.status = "unfinished";
+  }
+  return r;
+}
+
+// The point's axis and paired values into its row; its group: the axes other than J and seeds.
+void add_listed_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& out_dir,
+                      Collection& c) {
+  Row row;
+  row["point"] = p.name;
+  const PointResult r = point_result(spec, p, out_dir);
+  row["status"] = r.status;
+  std::string group_key;
+  json axes = json::object();
+  for (const auto& o : p.overrides) {
+    const auto eq = o.find('=');
+    const std::string key = o.substr(0, eq);
+    const bool is_axis = std::any_of(spec.axes.begin(), spec.axes.end(),
+                                     [&](const auto& a) { return a.first == key; });
+    const bool is_paired = std::any_of(spec.paired.begin(), spec.paired.end(),
+                                       [&](const auto& pk) { return pk.key == key; });
+    if (is_paired) row["paired." + key] = o.substr(eq + 1);
+    if (!is_axis) continue;
+    row["axis." + key] = o.substr(eq + 1);
+    if (key != "flow.J" && !is_seed_axis(key)) {
+      group_key += o + " ";
+      axes[key] = json::parse(o.substr(eq + 1), nullptr, false);
+    }
+  }
+  if (r.status == "done") {
+    ++c.finished;
+    c.add_summary(row, r.summary, group_key, axes, true);
+  }
+  c.table.push_back(std::move(row));
+}
+
+// Finished points in DIR that this sweep file does not list (a sweep over a part of them, or the
+// file edited since) stay in DIR's tables: their axis values come from the row the earlier
+// collection wrote, their numbers from their own summary. One whose row lacks an axis of this
+// sweep is listed but left out of the fits.
+void add_kept_points(const SweepSpec& spec, const std::set<std::string>& ours,
+                     const fs::path& out_dir, Collection& c) {
+  std::map<std::string, std::map<std::string, std::string>> earlier;
+  if (fs::exists(out_dir / "sweep.csv"))
+    for (auto& r : read_csv_rows(out_dir / "sweep.csv")) earlier[r["point"]] = r;
+  std::error_code ec;
+  if (!fs::is_directory(out_dir / "points", ec)) return;
+  for (const auto& e : fs::directory_iterator(out_dir / "points")) {
+    const std::string name = e.path().filename().string();
+    if (ours.count(name) || !fs::exists(e.path() / "summary.json")) continue;
+    std::ifstream in(e.path() / "summary.json");
+    const json summary = json::parse(in, nullptr, false);
+    if (summary.is_discarded()) continue;
+    Row row;
+    row["point"] = name;
+    const auto& before = earlier[name];
+    for (const auto& [col, text] : before)
+      if (col.starts_with("axis.") || col.starts_with("paired."))
+        row[col] = text, c.kept_axes.insert(col);
+    row["status"] = "done";
+    ++c.kept, ++c.finished;
+    std::string group_key;
+    json axes = json::object();
+    bool placed = true;
+    for (const auto& [key, values] : spec.axes) {
+      if (key == "flow.J" || is_seed_axis(key)) continue;
+      const auto it = before.find("axis." + key);
+      if (it == before.end() || it->second.empty()) {
+        placed = false;
+        break;
+      }
+      group_key += key + "=" + it->second + " ";
+      axes[key] = json::parse(it->second, nullptr, false);
+    }
+    c.add_summary(row, summary, group_key, axes, placed);
+    c.table.push_back(std::move(row));
+  }
+  if (c.kept > 0)
+    fmt::print(stderr,
+               "sweep: {} finished points in {} lie outside this sweep file's axes: they stay in "
+               "its sweep.csv and fits.json\n",
+               c.kept, (out_dir / "points").string());
+}
+
+// The store's sweep.csv and fits.json stand for every point it holds: a sweep over a part of
+// them (one J, one seed, run on another machine) stores its points but leaves those two files to
+// a sweep that covers the whole store, instead of replacing them with fits over its part.
+bool covers_the_store(const SweepSpec& spec, const std::set<std::string>& ours,
+                      const fs::path& out_dir) {
+  if (spec.results.empty()) return false;
+  if (!fs::is_directory(spec.results / "points")) return true;
+  for (const auto& e : fs::directory_iterator(spec.results / "points"))
+    if (fs::exists(e.path() / "summary.json") && !ours.count(e.path().filename().string())) {
+      fmt::print(stderr,
+                 "sweep: {} holds points outside this sweep's axes: its sweep.csv and fits.json "
+                 "are left as they were (collect a sweep file covering all of them to refresh "
+                 "them); this sweep's are in {}\n",
+                 spec.results.string(), out_dir.string());
+      return false;
+    }
+  return true;
+}
+
+// sweep.csv: fixed leading columns, then the axes, then every summary key.
+std::string sweep_csv(const SweepSpec& spec, const Collection& c) {
+  std::vector<std::string> columns = {"point", "status"};
+  for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
+  for (const auto& pk : spec.paired) columns.push_back("paired." + pk.key);
+  for (const auto& col : c.kept_axes)
+    if (std::find(columns.begin(), columns.end(), col) == columns.end()) columns.push_back(col);
+  columns.insert(columns.end(), c.summary_keys.begin(), c.summary_keys.end());
+  return csv_text(columns, c.table);
+}
+
+json fits_json(const SweepSpec& spec, std::size_t listed, Collection& c) {
+  json fits;
+  fits["sweep"] = spec.file.filename().string();
+  fits["points"] = listed + static_cast<std::size_t>(c.kept);
+  fits["finished"] = c.finished;
+  // The seed's Table 1 sits beside fits of J-sweeps only: a sweep of another scene (channel
+  // cases over seeds) has no J axis to fit and is not that paper's measurement.
+  if (!c.groups.empty()) fits["seed_table1"] = seed_reference();
+  fits["groups"] = json::array();
+  // Each J's seeds in seed order, however their points were found (listed by this sweep file or
+  // kept from an earlier one): the seed bootstrap draws by position.
+  for (auto& [key, by_j] : c.groups)
+    for (auto& [j, runs] : by_j)
+      std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
+        return a.value("seed", 0L) < b.value("seed", 0L);
+      });
+  for (const auto& [key, by_j] : c.groups)
+    fits["groups"].push_back(fits_of_group(by_j, c.group_axes[key]));
+  return fits;
+}
+
+}  // namespace
+
 json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
   if (!fs::is_directory(out_dir / "points") &&
       (spec.results.empty() || !fs::is_directory(spec.results / "points")))
@@ -346,178 +540,24 @@ json collect_sweep(const SweepSpec& spec, const fs::path& out_dir) {
         "{}: no sweep there (no points/ folder{})", out_dir.string(),
         spec.results.empty() ? "" : " and no stored results in " + spec.results.string()));
   const auto points = expand_points(spec);
-  std::vector<std::map<std::string, json>> table;
-  std::set<std::string> summary_keys;
-  // Groups: points equal on every axis but J and the seeds; within a group, rows by J.
-  std::map<std::string, std::map<double, std::vector<json>>> groups;
-  std::map<std::string, json> group_axes;
-  long finished = 0;
+  Collection c;
+  std::set<std::string> ours;
   for (const auto& p : points) {
-    std::map<std::string, json> row;
-    row["point"] = p.name;
-    auto dir = point_dir(out_dir, p);
-    json summary;
-    std::string status = "missing";
-    // A finished run directory is stored first; a point finished elsewhere is read from the
-    // store. A finished point whose config differs from the sweep's is an error, not a row.
-    const bool here =
-        fs::exists(dir / "summary.json") && point_state(spec, p, out_dir) == PointState::finished;
-    if (here) export_point(spec, p, out_dir);
-    if (!here)
-      if (const auto stored = stored_point(spec, p); !stored.empty()) dir = stored;
-    if (fs::exists(dir / "summary.json")) {
-      if (here || dir != point_dir(out_dir, p)) {
-        std::ifstream in(dir / "summary.json");
-        summary = json::parse(in);
-        status = "done";
-        ++finished;
-      }
-    } else if (fs::exists(out_dir / "logs" / (p.name + ".failed"))) {
-      std::ifstream in(out_dir / "logs" / (p.name + ".failed"));
-      std::string why;
-      std::getline(in, why);
-      status = "failed: " + why;
-    } else if (fs::exists(dir / "checkpoint.bin")) {
-      status = "unfinished";
-    }
-    row["status"] = status;
-    std::string group_key;
-    json axes = json::object();
-    for (const auto& o : p.overrides) {
-      const auto eq = o.find('=');
-      const std::string key = o.substr(0, eq);
-      const bool is_axis = std::any_of(spec.axes.begin(), spec.axes.end(),
-                                       [&](const auto& a) { return a.first == key; });
-      const bool is_paired = std::any_of(spec.paired.begin(), spec.paired.end(),
-                                         [&](const auto& pk) { return pk.key == key; });
-      if (is_paired) row["paired." + key] = o.substr(eq + 1);
-      if (!is_axis) continue;
-      row["axis." + key] = o.substr(eq + 1);
-      if (key != "flow.J" && !is_seed_axis(key)) {
-        group_key += o + " ";
-        axes[key] = json::parse(o.substr(eq + 1), nullptr, false);
-      }
-    }
-    if (status == "done") {
-      std::map<std::string, json> flat;
-      flatten(summary, flat);
-      for (auto& [k, v] : flat) {
-        summary_keys.insert(k);
-        row[k] = v;
-      }
-      const std::string verdict = window_verdict(summary);
-      if (!verdict.empty()) row["status"] = verdict;
-      if (summary.contains("J") && verdict.empty())
-        groups[group_key][summary["J"].get<double>()].push_back(summary);
-      group_axes[group_key] = axes;
-    }
-    table.push_back(std::move(row));
+    add_listed_point(spec, p, out_dir, c);
+    ours.insert(p.name);
   }
-
-  // Finished points in DIR that this sweep file does not list (a sweep over a part of them,
-  // or the file edited since) stay in DIR's tables: their axis values come from the row the
-  // earlier collection wrote, their numbers from their own summary. One whose row lacks an
-  // axis of this sweep is listed but left out of the fits.
-  std::set<std::string> ours, kept_axes;
-  for (const auto& p : points) ours.insert(p.name);
-  std::map<std::string, std::map<std::string, std::string>> earlier;
-  if (fs::exists(out_dir / "sweep.csv"))
-    for (auto& r : read_csv_rows(out_dir / "sweep.csv")) earlier[r["point"]] = r;
-  long kept = 0;
-  std::error_code ec;
-  if (fs::is_directory(out_dir / "points", ec))
-    for (const auto& e : fs::directory_iterator(out_dir / "points")) {
-      const std::string name = e.path().filename().string();
-      if (ours.count(name) || !fs::exists(e.path() / "summary.json")) continue;
-      std::ifstream in(e.path() / "summary.json");
-      const json summary = json::parse(in, nullptr, false);
-      if (summary.is_discarded()) continue;
-      std::map<std::string, json> row;
-      row["point"] = name;
-      const auto& before = earlier[name];
-      for (const auto& [col, text] : before)
-        if (col.starts_with("axis.") || col.starts_with("paired."))
-          row[col] = text, kept_axes.insert(col);
-      std::map<std::string, json> flat;
-      flatten(summary, flat);
-      for (auto& [k, v] : flat) summary_keys.insert(k), row[k] = v;
-      const std::string verdict = window_verdict(summary);
-      row["status"] = verdict.empty() ? std::string("done") : verdict;
-      ++kept, ++finished;
-      std::string group_key;
-      json axes = json::object();
-      bool placed = true;
-      for (const auto& [key, values] : spec.axes) {
-        if (key == "flow.J" || is_seed_axis(key)) continue;
-        const auto it = before.find("axis." + key);
-        if (it == before.end() || it->second.empty()) {
-          placed = false;
-          break;
-        }
-        group_key += key + "=" + it->second + " ";
-        axes[key] = json::parse(it->second, nullptr, false);
-      }
-      if (placed && verdict.empty() && summary.contains("J")) {
-        groups[group_key][summary["J"].get<double>()].push_back(summary);
-        group_axes[group_key] = axes;
-      }
-      table.push_back(std::move(row));
-    }
-  if (kept > 0)
-    fmt::print(stderr,
-               "sweep: {} finished points in {} lie outside this sweep file's axes: they stay in "
-               "its sweep.csv and fits.json\n",
-               kept, (out_dir / "points").string());
-
-  // sweep.csv: fixed leading columns, then the axes, then every summary key.
-  std::vector<std::string> columns = {"point", "status"};
-  for (const auto& [key, values] : spec.axes) columns.push_back("axis." + key);
-  for (const auto& pk : spec.paired) columns.push_back("paired." + pk.key);
-  for (const auto& col : kept_axes)
-    if (std::find(columns.begin(), columns.end(), col) == columns.end()) columns.push_back(col);
-  columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
+  add_kept_points(spec, ours, out_dir, c);
+  const std::string csv = sweep_csv(spec, c);
   fs::create_directories(out_dir);
-  write_file_atomically(out_dir / "sweep.csv", csv_text(columns, table));
-  // The store's sweep.csv and fits.json stand for every point it holds: a sweep over a part of
-  // them (one J, one seed, run on another machine) stores its points but leaves those two files
-  // to a sweep that covers the whole store, instead of replacing them with fits over its part.
-  bool whole_store = true;
-  if (!spec.results.empty() && fs::is_directory(spec.results / "points")) {
-    for (const auto& e : fs::directory_iterator(spec.results / "points"))
-      if (fs::exists(e.path() / "summary.json") && !ours.count(e.path().filename().string()))
-        whole_store = false;
-    if (!whole_store)
-      fmt::print(stderr,
-                 "sweep: {} holds points outside this sweep's axes: its sweep.csv and fits.json "
-                 "are left as they were (collect a sweep file covering all of them to refresh "
-                 "them); this sweep's are in {}\n",
-                 spec.results.string(), out_dir.string());
-  }
-  if (!spec.results.empty() && whole_store) {
+  write_file_atomically(out_dir / "sweep.csv", csv);
+  const bool whole_store = covers_the_store(spec, ours, out_dir);
+  if (whole_store) {
     fs::create_directories(spec.results);
-    write_file_atomically(spec.results / "sweep.csv", csv_text(columns, table));
+    write_file_atomically(spec.results / "sweep.csv", csv);
   }
-
-  json fits;
-  fits["sweep"] = spec.file.filename().string();
-  fits["points"] = points.size() + static_cast<std::size_t>(kept);
-  fits["finished"] = finished;
-  // The seed's Table 1 sits beside fits of J-sweeps only: a sweep of another scene (channel
-  // cases over seeds) has no J axis to fit and is not that paper's measurement.
-  if (!groups.empty()) fits["seed_table1"] = seed_reference();
-  fits["groups"] = json::array();
-  // Each J's seeds in seed order, however their points were found (listed by this sweep file or
-  // kept from an earlier one): the seed bootstrap draws by position.
-  for (auto& [key, by_j] : groups)
-    for (auto& [j, runs] : by_j)
-      std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
-        return a.value("seed", 0L) < b.value("seed", 0L);
-      });
-  for (const auto& [key, by_j] : groups)
-    fits["groups"].push_back(fits_of_group(by_j, group_axes[key]));
+  const json fits = fits_json(spec, points.size(), c);
   write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
-  if (!spec.results.empty() && whole_store)
-    write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
+  if (whole_store) write_file_atomically(spec.results / "fits.json", json_text(fits) + "\n");
   return fits;
 }
 
