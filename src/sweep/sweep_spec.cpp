@@ -80,24 +80,11 @@ bool is_sweep_file(const fs::path& file) {
   }
 }
 
-SweepSpec load_sweep(const fs::path& file) {
-  SweepSpec spec;
-  spec.file = fs::absolute(file);
-  const std::string origin = file.string();
-  toml::table root;
-  try {
-    root = toml::parse_file(spec.file.string());
-  } catch (const toml::parse_error& e) {
-    throw ConfigError(fmt::format("{}: not valid TOML: {} (line {})", origin, e.description(),
-                                  e.source().begin.line));
-  }
-  reject_unknown(root, {"sweep", "slurm"}, origin);
-  const auto* sweep = root["sweep"].as_table();
-  if (!sweep) throw ConfigError(fmt::format("{}: missing the [sweep] table", origin));
-  const std::string w = origin + ": sweep";
-  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes", "paired", "results"}, w);
+namespace {
 
-  const auto base = get_or<std::string>(*sweep, "base", "", w);
+// [sweep] base, results, jobs and backend, paths relative to the sweep file.
+void read_where_and_how(const toml::table& sweep, const std::string& w, SweepSpec& spec) {
+  const auto base = get_or<std::string>(sweep, "base", "", w);
   if (base.empty()) throw ConfigError(fmt::format("{}.base: missing (the base config file)", w));
   spec.base = fs::path(base).is_absolute() ? fs::path(base) : spec.file.parent_path() / base;
   spec.base = spec.base.lexically_normal();
@@ -109,24 +96,27 @@ SweepSpec load_sweep(const fs::path& file) {
         fmt::format("{}.base = \"{}\": {} is {}, not a config file", w, base, spec.base.string(),
                     fs::is_directory(spec.base) ? "a directory" : "not a regular file"));
 
-  if (const auto results = get_or<std::string>(*sweep, "results", "", w); !results.empty())
+  if (const auto results = get_or<std::string>(sweep, "results", "", w); !results.empty())
     spec.results =
         (fs::path(results).is_absolute() ? fs::path(results) : spec.file.parent_path() / results)
             .lexically_normal();
 
-  spec.jobs = static_cast<int>(get_or<int64_t>(*sweep, "jobs", 2, w));
+  spec.jobs = static_cast<int>(get_or<int64_t>(sweep, "jobs", 2, w));
   if (spec.jobs < 1 || spec.jobs > 256)
     throw ConfigError(fmt::format("{}.jobs = {}: must be in [1, 256]", w, spec.jobs));
-  spec.backend = get_or<std::string>(*sweep, "backend", "local", w);
+  spec.backend = get_or<std::string>(sweep, "backend", "local", w);
   if (spec.backend != "local" && spec.backend != "slurm")
     throw ConfigError(
         fmt::format("{}.backend = \"{}\": must be \"local\" or \"slurm\"", w, spec.backend));
+}
 
-  if (const auto* set = (*sweep)["set"].as_table())
+// [sweep.axes] in the order the file gives them, and [sweep.set].
+void read_set_and_axes(const toml::table& sweep, const std::string& w, SweepSpec& spec) {
+  if (const auto* set = sweep["set"].as_table())
     for (const auto& [k, v] : *set)
       spec.set.emplace_back(std::string(k.str()),
                             value_text(v, fmt::format("{}.set.\"{}\"", w, k.str())));
-  const auto* axes = (*sweep)["axes"].as_table();
+  const auto* axes = sweep["axes"].as_table();
   if (!axes || axes->empty())
     throw ConfigError(
         fmt::format("{}.axes: missing; give at least one axis, e.g. "
@@ -170,76 +160,81 @@ SweepSpec load_sweep(const fs::path& file) {
         throw ConfigError(fmt::format(
             "{}.set.\"{}\": also an axis ({}.axes.\"{}\"); give it in one place", w, k, w, k));
   }
-  if (const auto* node = sweep->get("paired")) {
-    const auto* paired = node->as_table();
-    if (!paired)
-      throw ConfigError(
-          fmt::format("{}.paired: must be a table of axes, e.g. [sweep.paired.\"flow.J\"] "
-                      "\"particles.phi_init\" = [0.74, 0.62]",
-                      w));
-    std::set<std::string> taken;
-    for (const auto& [ak, an] : *paired) {
-      const std::string axis_key(ak.str());
-      const std::string where = fmt::format("{}.paired.\"{}\"", w, axis_key);
-      const auto axis = std::find_if(spec.axes.begin(), spec.axes.end(),
-                                     [&](const auto& a) { return a.first == axis_key; });
-      if (axis == spec.axes.end())
-        throw ConfigError(fmt::format("{}: \"{}\" is not an axis of {}.axes", where, axis_key, w));
-      const auto* keys = an.as_table();
-      if (!keys || keys->empty())
-        throw ConfigError(fmt::format(
-            "{}: must be a table of keys, each a list of one value per entry of the axis", where));
-      for (const auto& [kk, kv] : *keys) {
-        const std::string key(kk.str());
-        const std::string wk = fmt::format("{}.\"{}\"", where, key);
-        const auto* arr = kv.as_array();
-        if (!arr || arr->size() != axis->second.size())
-          throw ConfigError(
-              fmt::format("{}: must be a list of {} values, one per entry of the axis", wk,
-                          axis->second.size()));
-        const bool in_axes = std::any_of(spec.axes.begin(), spec.axes.end(),
-                                         [&](const auto& a) { return a.first == key; });
-        const bool in_set = std::any_of(spec.set.begin(), spec.set.end(),
-                                        [&](const auto& s) { return s.first == key; });
-        if (in_axes || in_set || !taken.insert(key).second)
-          throw ConfigError(fmt::format("{}: the key is also {}; give it in one place", wk,
-                                        in_axes  ? "an axis"
-                                        : in_set ? "in [sweep.set]"
-                                                 : "paired with another axis"));
-        std::vector<std::string> values;
-        for (const auto& e : *arr) values.push_back(value_text(e, wk));
-        spec.paired.push_back(
-            {static_cast<std::size_t>(axis - spec.axes.begin()), key, std::move(values)});
-      }
+}
+
+// [sweep.paired."AXIS"]: keys that take one value per entry of an axis.
+void read_paired(const toml::node& node, const std::string& w, SweepSpec& spec) {
+  const auto* paired = node.as_table();
+  if (!paired)
+    throw ConfigError(
+        fmt::format("{}.paired: must be a table of axes, e.g. [sweep.paired.\"flow.J\"] "
+                    "\"particles.phi_init\" = [0.74, 0.62]",
+                    w));
+  std::set<std::string> taken;
+  for (const auto& [ak, an] : *paired) {
+    const std::string axis_key(ak.str());
+    const std::string where = fmt::format("{}.paired.\"{}\"", w, axis_key);
+    const auto axis = std::find_if(spec.axes.begin(), spec.axes.end(),
+                                   [&](const auto& a) { return a.first == axis_key; });
+    if (axis == spec.axes.end())
+      throw ConfigError(fmt::format("{}: \"{}\" is not an axis of {}.axes", where, axis_key, w));
+    const auto* keys = an.as_table();
+    if (!keys || keys->empty())
+      throw ConfigError(fmt::format(
+          "{}: must be a table of keys, each a list of one value per entry of the axis", where));
+    for (const auto& [kk, kv] : *keys) {
+      const std::string key(kk.str());
+      const std::string wk = fmt::format("{}.\"{}\"", where, key);
+      const auto* arr = kv.as_array();
+      if (!arr || arr->size() != axis->second.size())
+        throw ConfigError(
+            fmt::format("{}: must be a list of {} values, one per entry of the axis", wk,
+                        axis->second.size()));
+      const bool in_axes = std::any_of(spec.axes.begin(), spec.axes.end(),
+                                       [&](const auto& a) { return a.first == key; });
+      const bool in_set = std::any_of(spec.set.begin(), spec.set.end(),
+                                      [&](const auto& s) { return s.first == key; });
+      if (in_axes || in_set || !taken.insert(key).second)
+        throw ConfigError(fmt::format("{}: the key is also {}; give it in one place", wk,
+                                      in_axes  ? "an axis"
+                                      : in_set ? "in [sweep.set]"
+                                               : "paired with another axis"));
+      std::vector<std::string> values;
+      for (const auto& e : *arr) values.push_back(value_text(e, wk));
+      spec.paired.push_back(
+          {static_cast<std::size_t>(axis - spec.axes.begin()), key, std::move(values)});
     }
   }
+}
 
-  if (const auto* s = root["slurm"].as_table()) {
-    const std::string ws = origin + ": slurm";
-    reject_unknown(
-        *s, {"throttle", "time", "partition", "job_name", "cpus_per_task", "mem_per_task", "extra"},
-        ws);
-    spec.slurm.throttle = static_cast<int>(get_or<int64_t>(*s, "throttle", 0, ws));
-    if (spec.slurm.throttle < 0)
-      throw ConfigError(
-          fmt::format("{}.throttle = {}: must be >= 0 (0 = no limit)", ws, spec.slurm.throttle));
-    spec.slurm.time = get_or<std::string>(*s, "time", spec.slurm.time, ws);
-    spec.slurm.partition = get_or<std::string>(*s, "partition", "", ws);
-    spec.slurm.job_name = get_or<std::string>(*s, "job_name", spec.slurm.job_name, ws);
-    spec.slurm.cpus_per_task = static_cast<int>(get_or<int64_t>(*s, "cpus_per_task", 1, ws));
-    if (spec.slurm.cpus_per_task < 1)
-      throw ConfigError(
-          fmt::format("{}.cpus_per_task = {}: must be >= 1", ws, spec.slurm.cpus_per_task));
-    spec.slurm.mem_per_task = get_or<std::string>(*s, "mem_per_task", spec.slurm.mem_per_task, ws);
-    if (const auto* extra = (*s)["extra"].as_array())
-      for (const auto& e : *extra) {
-        auto str = e.value<std::string>();
-        if (!str) throw ConfigError(fmt::format("{}.extra: must be a list of strings", ws));
-        spec.slurm.extra.push_back(*str);
-      }
-  }
+// [slurm]: how the Slurm backend submits the points.
+void read_slurm(const toml::table& s, const std::string& origin, SweepSpec& spec) {
+  const std::string ws = origin + ": slurm";
+  reject_unknown(
+      s, {"throttle", "time", "partition", "job_name", "cpus_per_task", "mem_per_task", "extra"},
+      ws);
+  spec.slurm.throttle = static_cast<int>(get_or<int64_t>(s, "throttle", 0, ws));
+  if (spec.slurm.throttle < 0)
+    throw ConfigError(
+        fmt::format("{}.throttle = {}: must be >= 0 (0 = no limit)", ws, spec.slurm.throttle));
+  spec.slurm.time = get_or<std::string>(s, "time", spec.slurm.time, ws);
+  spec.slurm.partition = get_or<std::string>(s, "partition", "", ws);
+  spec.slurm.job_name = get_or<std::string>(s, "job_name", spec.slurm.job_name, ws);
+  spec.slurm.cpus_per_task = static_cast<int>(get_or<int64_t>(s, "cpus_per_task", 1, ws));
+  if (spec.slurm.cpus_per_task < 1)
+    throw ConfigError(
+        fmt::format("{}.cpus_per_task = {}: must be >= 1", ws, spec.slurm.cpus_per_task));
+  spec.slurm.mem_per_task = get_or<std::string>(s, "mem_per_task", spec.slurm.mem_per_task, ws);
+  if (const auto* extra = s["extra"].as_array())
+    for (const auto& e : *extra) {
+      auto str = e.value<std::string>();
+      if (!str) throw ConfigError(fmt::format("{}.extra: must be a list of strings", ws));
+      spec.slurm.extra.push_back(*str);
+    }
+}
 
-  // Every point must be a valid run, and a run of its own, before any of them starts.
+// Every point must be a valid run, and a run of its own, before any of them starts.
+void check_points(const SweepSpec& spec, const std::string& origin) {
   std::map<std::string, std::string> point_of_config;
   for (const auto& p : expand_points(spec)) {
     Config cfg;
@@ -257,6 +252,31 @@ SweepSpec load_sweep(const fs::path& file) {
           "fits.json; remove one",
           origin, it->second, p.name));
   }
+}
+
+}  // namespace
+
+SweepSpec load_sweep(const fs::path& file) {
+  SweepSpec spec;
+  spec.file = fs::absolute(file);
+  const std::string origin = file.string();
+  toml::table root;
+  try {
+    root = toml::parse_file(spec.file.string());
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(fmt::format("{}: not valid TOML: {} (line {})", origin, e.description(),
+                                  e.source().begin.line));
+  }
+  reject_unknown(root, {"sweep", "slurm"}, origin);
+  const auto* sweep = root["sweep"].as_table();
+  if (!sweep) throw ConfigError(fmt::format("{}: missing the [sweep] table", origin));
+  const std::string w = origin + ": sweep";
+  reject_unknown(*sweep, {"base", "jobs", "backend", "set", "axes", "paired", "results"}, w);
+  read_where_and_how(*sweep, w, spec);
+  read_set_and_axes(*sweep, w, spec);
+  if (const auto* node = sweep->get("paired")) read_paired(*node, w, spec);
+  if (const auto* s = root["slurm"].as_table()) read_slurm(*s, origin, spec);
+  check_points(spec, origin);
   return spec;
 }
 
