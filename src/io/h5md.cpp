@@ -601,6 +601,14 @@ struct H5mdWriter::Impl {
     return s;
   }
 
+  void create_suspension();
+  void create_observables();
+  void create_contacts();
+  void check_frame(const FrameData& frame, bool want_unwrapped) const;
+  void append_images(const FrameData& frame, double tilt, double ly);
+  void append_velocity(const FrameData& frame);
+  void append_contacts(const ContactNetwork& c);
+
   void create_unwrapped() {
     const hsize_t n = layout.n_particles;
     image = element(susp("image"), H5T_STD_I32LE, {n, 2}, 1, kNumber);
@@ -608,11 +616,10 @@ struct H5mdWriter::Impl {
   }
 };
 
-H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
-    : impl_(std::make_unique<Impl>()) {
-  Impl& m = *impl_;
-  m.path = path;
-  m.layout = layout;
+namespace {
+
+// Whether the layout can be written: sizes agree, observable names are valid and distinct.
+void check_layout(const fs::path& path, const TrajectoryLayout& layout) {
   const std::size_t n = layout.n_particles;
   if (n == 0) fail(path, kSuspension, "layout has no particles");
   if (layout.species.size() != n || layout.diameter.size() != n || layout.motion.size() != n) {
@@ -633,15 +640,10 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
       }
     }
   }
-  for (double d : layout.diameter) m.max_diameter = std::max(m.max_diameter, d);
+}
 
-  {
-    ErrorPrintGuard quiet;
-    m.file = checked(H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                     H5Fclose, path, "/", "cannot create file");
-  }
-  const hid_t f = m.file.get();
-
+// /h5md (version, author, creator, units module) and /parameters (the run's configuration).
+void write_h5md_header(hid_t f, const fs::path& path, const TrajectoryLayout& layout) {
   {
     Handle h5md = create_group(f, "/h5md", path);
     write_int_attr(h5md.get(), "/h5md", "version", {1, 1}, false, path);
@@ -667,7 +669,15 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
     Handle parameters = create_group(f, "/parameters", path);
     write_string_attr(parameters.get(), "/parameters", "config", {layout.config_toml}, true, path);
   }
+}
 
+}  // namespace
+
+// /particles/suspension: the box, the position series (whose step and time every element
+// links), velocities where written, and the per-particle constants (species, motion, diameter).
+void H5mdWriter::Impl::create_suspension() {
+  const hid_t f = file.get();
+  const std::size_t n = layout.n_particles;
   Handle particles = create_group(f, "/particles", path);
   Handle suspension = create_group(f, kSuspension, path);
   {
@@ -680,16 +690,16 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
   }
   {
     Handle position_group = create_group(f, susp("position"), path);
-    m.step = create_series(f, kStep, H5T_STD_I64LE, {}, kScalarChunk, path);
-    m.time = create_series(f, kTimeName, H5T_IEEE_F64LE, {}, kScalarChunk, path);
-    write_unit(m.time.ds.get(), kTimeName, kTime, path);
-    m.position = create_series(f, susp("position/value"), H5T_IEEE_F64LE, {n, 2}, 1, path);
-    write_unit(m.position.ds.get(), m.position.name, kLength, path);
+    step = create_series(f, kStep, H5T_STD_I64LE, {}, kScalarChunk, path);
+    time = create_series(f, kTimeName, H5T_IEEE_F64LE, {}, kScalarChunk, path);
+    write_unit(time.ds.get(), kTimeName, kTime, path);
+    position = create_series(f, susp("position/value"), H5T_IEEE_F64LE, {n, 2}, 1, path);
+    write_unit(position.ds.get(), position.name, kLength, path);
   }
-  m.edges = m.element(susp("box/edges"), H5T_IEEE_F64LE, {2, 2}, kScalarChunk, kLength);
+  edges = element(susp("box/edges"), H5T_IEEE_F64LE, {2, 2}, kScalarChunk, kLength);
   if (layout.write_velocity) {
-    m.velocity = m.element(susp("velocity"), H5T_IEEE_F64LE, {n, 2}, 1, kVelocity);
-    m.angular_velocity = m.element(susp("angular_velocity"), H5T_IEEE_F64LE, {n}, 1, kRate);
+    velocity = element(susp("velocity"), H5T_IEEE_F64LE, {n, 2}, 1, kVelocity);
+    angular_velocity = element(susp("angular_velocity"), H5T_IEEE_F64LE, {n}, 1, kRate);
   }
   {
     // HDF5 converts enumerations to numbers on reading, not numbers to enumerations.
@@ -707,47 +717,70 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
   }
   write_fixed_dataset(f, susp("diameter"), H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {n},
                       layout.diameter.data(), kLength, path);
+}
 
+void H5mdWriter::Impl::create_observables() {
+  const hid_t f = file.get();
   Handle obs_group = create_group(f, "/observables", path);
   for (std::size_t k = 0; k < layout.observables.size(); ++k) {
     const std::string unit = layout.observable_units.empty() ? kNumber : layout.observable_units[k];
-    m.observables.push_back(
-        m.element("/observables/" + layout.observables[k], H5T_IEEE_F64LE, {}, kScalarChunk, unit));
+    observables.push_back(
+        element("/observables/" + layout.observables[k], H5T_IEEE_F64LE, {}, kScalarChunk, unit));
   }
-
-  if (layout.write_contacts) {
-    Handle connectivity = create_group(f, "/connectivity", path);
-    Handle contacts = create_group(f, kContacts, path);
-    hobj_ref_t ref;
-    check(H5Rcreate(&ref, f, kSuspension, H5R_OBJECT, -1), path, kContacts,
-          "cannot reference the particle group");
-    {
-      const std::string where = std::string(kContacts) + "@particles_group";
-      Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, path, where, "dataspace");
-      Handle a = checked(H5Acreate2(contacts.get(), "particles_group", H5T_STD_REF_OBJ, space.get(),
-                                    H5P_DEFAULT, H5P_DEFAULT),
-                         H5Aclose, path, where, "cannot create attribute");
-      check(H5Awrite(a.get(), H5T_STD_REF_OBJ, &ref), path, where, "cannot write attribute");
-    }
-    const std::string c = kContacts;
-    hard_link(f, kStep, c + "/step", path);
-    hard_link(f, kTimeName, c + "/time", path);
-    const std::int32_t no_pair = -1;
-    const double no_force = std::numeric_limits<double>::quiet_NaN();
-    const std::int8_t no_flag = -1;
-    m.pairs = create_series(f, c + "/value", H5T_STD_I32LE, {0, 2}, 1, path, &no_pair);
-    m.normal_force = create_series(f, c + "/normal_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
-    m.tangential_force =
-        create_series(f, c + "/tangential_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
-    m.sliding = create_series(f, c + "/sliding", H5T_STD_I8LE, {0}, 1, path, &no_flag);
-    write_unit(m.pairs->ds.get(), m.pairs->name, kNumber, path);
-    write_unit(m.normal_force->ds.get(), m.normal_force->name, kForce, path);
-    write_unit(m.tangential_force->ds.get(), m.tangential_force->name, kForce, path);
-    write_unit(m.sliding->ds.get(), m.sliding->name, kNumber, path);
-  }
-  check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
 }
 
+// /connectivity/contacts: ragged per-frame lists of pairs and their forces, linked to the
+// particle group.
+void H5mdWriter::Impl::create_contacts() {
+  const hid_t f = file.get();
+  Handle connectivity = create_group(f, "/connectivity", path);
+  Handle contacts = create_group(f, kContacts, path);
+  hobj_ref_t ref;
+  check(H5Rcreate(&ref, f, kSuspension, H5R_OBJECT, -1), path, kContacts,
+        "cannot reference the particle group");
+  {
+    const std::string where = std::string(kContacts) + "@particles_group";
+    Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, path, where, "dataspace");
+    Handle a = checked(H5Acreate2(contacts.get(), "particles_group", H5T_STD_REF_OBJ, space.get(),
+                                  H5P_DEFAULT, H5P_DEFAULT),
+                       H5Aclose, path, where, "cannot create attribute");
+    check(H5Awrite(a.get(), H5T_STD_REF_OBJ, &ref), path, where, "cannot write attribute");
+  }
+  const std::string c = kContacts;
+  hard_link(f, kStep, c + "/step", path);
+  hard_link(f, kTimeName, c + "/time", path);
+  const std::int32_t no_pair = -1;
+  const double no_force = std::numeric_limits<double>::quiet_NaN();
+  const std::int8_t no_flag = -1;
+  pairs = create_series(f, c + "/value", H5T_STD_I32LE, {0, 2}, 1, path, &no_pair);
+  normal_force = create_series(f, c + "/normal_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+  tangential_force =
+      create_series(f, c + "/tangential_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+  sliding = create_series(f, c + "/sliding", H5T_STD_I8LE, {0}, 1, path, &no_flag);
+  write_unit(pairs->ds.get(), pairs->name, kNumber, path);
+  write_unit(normal_force->ds.get(), normal_force->name, kForce, path);
+  write_unit(tangential_force->ds.get(), tangential_force->name, kForce, path);
+  write_unit(sliding->ds.get(), sliding->name, kNumber, path);
+}
+
+H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
+    : impl_(std::make_unique<Impl>()) {
+  check_layout(path, layout);
+  Impl& m = *impl_;
+  m.path = path;
+  m.layout = layout;
+  for (double d : layout.diameter) m.max_diameter = std::max(m.max_diameter, d);
+  {
+    ErrorPrintGuard quiet;
+    m.file = checked(H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                     H5Fclose, path, "/", "cannot create file");
+  }
+  write_h5md_header(m.file.get(), path, layout);
+  m.create_suspension();
+  m.create_observables();
+  if (layout.write_contacts) m.create_contacts();
+  check(H5Fflush(m.file.get(), H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
+}
 H5mdWriter::H5mdWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layout,
@@ -798,54 +831,114 @@ H5mdWriter::~H5mdWriter() = default;
 H5mdWriter::H5mdWriter(H5mdWriter&&) noexcept = default;
 H5mdWriter& H5mdWriter::operator=(H5mdWriter&&) noexcept = default;
 
-void H5mdWriter::write_frame(const FrameData& frame) {
-  if (!impl_) throw std::logic_error("H5mdWriter: write_frame on a moved-from writer");
-  Impl& m = *impl_;
-  const std::size_t n = m.layout.n_particles;
+// Everything about a frame is checked before its first write, so a bad frame leaves the file
+// consistent.
+void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_unwrapped) const {
+  const std::size_t n = layout.n_particles;
   const auto check_size = [&](std::size_t got, const std::string& name) {
     if (got != n) {
-      fail(m.path, name,
-           fmt::format("frame {} (step {}) has {} entries, expected {}", m.frames, frame.step, got,
+      fail(path, name,
+           fmt::format("frame {} (step {}) has {} entries, expected {}", frames, frame.step, got,
                        n));
     }
   };
-
-  // Validate everything before the first write so a bad frame leaves the file consistent.
-  if (frame.position == nullptr) fail(m.path, susp("position"), "frame without positions");
+  if (frame.position == nullptr) fail(path, susp("position"), "frame without positions");
   check_size(frame.position->size(), susp("position"));
-  if (m.layout.write_velocity) {
-    if (frame.velocity == nullptr) fail(m.path, susp("velocity"), "frame without velocities");
+  if (layout.write_velocity) {
+    if (frame.velocity == nullptr) fail(path, susp("velocity"), "frame without velocities");
     check_size(frame.velocity->size(), susp("velocity"));
   }
-  const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
   if (want_unwrapped) {
     if (frame.unwrapped == nullptr) {
-      fail(m.path, susp("unwrapped_position"),
+      fail(path, susp("unwrapped_position"),
            "unwrapped positions were written at frame 0 but are missing now");
     }
     check_size(frame.unwrapped->size(), susp("unwrapped_position"));
   }
-  if (frame.observables.size() != m.layout.observables.size()) {
-    fail(m.path, "/observables",
+  if (frame.observables.size() != layout.observables.size()) {
+    fail(path, "/observables",
          fmt::format("frame has {} observable values, layout names {}", frame.observables.size(),
-                     m.layout.observables.size()));
+                     layout.observables.size()));
   }
-  if (m.layout.write_contacts) {
+  if (layout.write_contacts) {
     const ContactNetwork* c = frame.contacts;
-    if (c == nullptr) fail(m.path, kContacts, "frame without its contact network");
+    if (c == nullptr) fail(path, kContacts, "frame without its contact network");
     const std::size_t k = c->pairs.size();
     if (c->normal_force.size() != k || c->tangential_force.size() != k || c->sliding.size() != k)
-      fail(m.path, kContacts, "contact arrays of different lengths");
+      fail(path, kContacts, "contact arrays of different lengths");
     for (const auto& pr : c->pairs)
       for (int i : pr)
         if (i < 0 || static_cast<std::size_t>(i) >= n)
-          fail(m.path, kContacts, fmt::format("particle index {} out of [0, {})", i, n));
+          fail(path, kContacts, fmt::format("particle index {} out of [0, {})", i, n));
   }
-  if (!(frame.lx > 0.0) || (m.layout.lees_edwards && !(frame.ly > 0.0)) ||
-      !std::isfinite(frame.tilt))
-    fail(m.path, susp("box/edges"),
+  if (!(frame.lx > 0.0) || (layout.lees_edwards && !(frame.ly > 0.0)) || !std::isfinite(frame.tilt))
+    fail(path, susp("box/edges"),
          fmt::format("invalid box lx = {}, ly = {}, tilt = {}", frame.lx, frame.ly, frame.tilt));
+}
 
+void H5mdWriter::Impl::append_images(const FrameData& frame, double tilt, double ly) {
+  const std::size_t n = layout.n_particles;
+  const std::vector<Vec2>& pos = *frame.position;
+  const double lx = frame.lx;
+  // position + image . edges is continuous in time (the convention of LAMMPS and GSD): the
+  // engine's counts of the images crossed, re-expressed for the reduced tilt of `edges`
+  // (tilt = offset - m lx adds m to the x count of each y image). It equals the unwrapped
+  // position in y; in x the two differ by the Lees-Edwards shift gained since each crossing.
+  const std::vector<Vec2>& u = *frame.unwrapped;
+  std::vector<std::int32_t> img(2 * n);
+  const double m_tilt = layout.lees_edwards ? std::round(frame.tilt / lx) : 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (frame.image != nullptr) {
+      const auto [ix, iy] = (*frame.image)[i];
+      img[2 * i] = static_cast<std::int32_t>(ix + static_cast<int>(m_tilt) * iy);
+      img[2 * i + 1] = static_cast<std::int32_t>(iy);
+      continue;
+    }
+    const double iy = layout.lees_edwards ? std::round((u[i].y() - pos[i].y()) / ly) : 0.0;
+    img[2 * i] = static_cast<std::int32_t>(std::round((u[i].x() - pos[i].x() - iy * tilt) / lx));
+    img[2 * i + 1] = static_cast<std::int32_t>(iy);
+  }
+  image->append(H5T_NATIVE_INT32, img.data(), path);
+  std::vector<double> buf(2 * n);
+  for (std::size_t i = 0; i < n; ++i) buf[2 * i] = u[i].x(), buf[2 * i + 1] = u[i].y();
+  unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), path);
+}
+
+void H5mdWriter::Impl::append_velocity(const FrameData& frame) {
+  const std::size_t n = layout.n_particles;
+  std::vector<double> buf(2 * n);
+  const auto& v = *frame.velocity;
+  std::vector<double> omega(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    buf[2 * i] = v[i].x();
+    buf[2 * i + 1] = v[i].y();
+    omega[i] = v[i].z();
+  }
+  velocity.append(H5T_NATIVE_DOUBLE, buf.data(), path);
+  angular_velocity.append(H5T_NATIVE_DOUBLE, omega.data(), path);
+}
+
+void H5mdWriter::Impl::append_contacts(const ContactNetwork& c) {
+  const hsize_t k = c.pairs.size();
+  std::vector<std::int32_t> ij(2 * k);
+  std::vector<std::int8_t> flag(k);
+  for (hsize_t q = 0; q < k; ++q) {
+    ij[2 * q] = c.pairs[q][0];
+    ij[2 * q + 1] = c.pairs[q][1];
+    flag[q] = c.sliding[q] != 0 ? 1 : 0;
+  }
+  pairs->append(H5T_NATIVE_INT32, ij.data(), path, k);
+  normal_force->append(H5T_NATIVE_DOUBLE, c.normal_force.data(), path, k);
+  tangential_force->append(H5T_NATIVE_DOUBLE, c.tangential_force.data(), path, k);
+  sliding->append(H5T_NATIVE_INT8, flag.data(), path, k);
+}
+
+void H5mdWriter::write_frame(const FrameData& frame) {
+  if (!impl_) throw std::logic_error("H5mdWriter: write_frame on a moved-from writer");
+  Impl& m = *impl_;
+  const std::size_t n = m.layout.n_particles;
+  const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
+  m.check_frame(frame, want_unwrapped);
   if (m.frames == 0 && want_unwrapped) m.create_unwrapped();
 
   const std::vector<Vec2>& pos = *frame.position;
@@ -864,67 +957,14 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   m.time.append(H5T_NATIVE_DOUBLE, &frame.time, m.path);
   const double edges[4] = {lx, 0.0, tilt, ly};  // rows: the edge vectors (lx, 0) and (tilt, ly)
   m.edges.append(H5T_NATIVE_DOUBLE, edges, m.path);
-
   std::vector<double> buf(2 * n);
-  const auto flatten2 = [&](const std::vector<Vec2>& v) {
-    for (std::size_t i = 0; i < n; ++i) {
-      buf[2 * i] = v[i].x();
-      buf[2 * i + 1] = v[i].y();
-    }
-  };
-  flatten2(pos);
+  for (std::size_t i = 0; i < n; ++i) buf[2 * i] = pos[i].x(), buf[2 * i + 1] = pos[i].y();
   m.position.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
-  if (m.unwrapped) {
-    // position + image . edges is continuous in time (the convention of LAMMPS and GSD): the
-    // engine's counts of the images crossed, re-expressed for the reduced tilt of `edges`
-    // (tilt = offset - m lx adds m to the x count of each y image). It equals the unwrapped
-    // position in y; in x the two differ by the Lees-Edwards shift gained since each crossing.
-    const std::vector<Vec2>& u = *frame.unwrapped;
-    std::vector<std::int32_t> img(2 * n);
-    const double m_tilt = m.layout.lees_edwards ? std::round(frame.tilt / lx) : 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (frame.image != nullptr) {
-        const auto [ix, iy] = (*frame.image)[i];
-        img[2 * i] = static_cast<std::int32_t>(ix + static_cast<int>(m_tilt) * iy);
-        img[2 * i + 1] = static_cast<std::int32_t>(iy);
-        continue;
-      }
-      const double iy = m.layout.lees_edwards ? std::round((u[i].y() - pos[i].y()) / ly) : 0.0;
-      img[2 * i] = static_cast<std::int32_t>(std::round((u[i].x() - pos[i].x() - iy * tilt) / lx));
-      img[2 * i + 1] = static_cast<std::int32_t>(iy);
-    }
-    m.image->append(H5T_NATIVE_INT32, img.data(), m.path);
-    flatten2(u);
-    m.unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
-  }
-  if (m.layout.write_velocity) {
-    const auto& v = *frame.velocity;
-    std::vector<double> omega(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      buf[2 * i] = v[i].x();
-      buf[2 * i + 1] = v[i].y();
-      omega[i] = v[i].z();
-    }
-    m.velocity.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
-    m.angular_velocity.append(H5T_NATIVE_DOUBLE, omega.data(), m.path);
-  }
+  if (m.unwrapped) m.append_images(frame, tilt, ly);
+  if (m.layout.write_velocity) m.append_velocity(frame);
   for (std::size_t k = 0; k < m.observables.size(); ++k)
     m.observables[k].append(H5T_NATIVE_DOUBLE, &frame.observables[k], m.path);
-  if (m.layout.write_contacts) {
-    const ContactNetwork& c = *frame.contacts;
-    const hsize_t k = c.pairs.size();
-    std::vector<std::int32_t> ij(2 * k);
-    std::vector<std::int8_t> flag(k);
-    for (hsize_t q = 0; q < k; ++q) {
-      ij[2 * q] = c.pairs[q][0];
-      ij[2 * q + 1] = c.pairs[q][1];
-      flag[q] = c.sliding[q] != 0 ? 1 : 0;
-    }
-    m.pairs->append(H5T_NATIVE_INT32, ij.data(), m.path, k);
-    m.normal_force->append(H5T_NATIVE_DOUBLE, c.normal_force.data(), m.path, k);
-    m.tangential_force->append(H5T_NATIVE_DOUBLE, c.tangential_force.data(), m.path, k);
-    m.sliding->append(H5T_NATIVE_INT8, flag.data(), m.path, k);
-  }
+  if (m.layout.write_contacts) m.append_contacts(*frame.contacts);
   ++m.frames;
 }
 

@@ -164,7 +164,11 @@ class WorkerPool {
  public:
   WorkerPool(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
              bool progress_lines)
-      : spec_(spec), out_dir_(out_dir), jobs_(jobs), exe_(exe), progress_lines_(progress_lines),
+      : spec_(spec),
+        out_dir_(out_dir),
+        jobs_(jobs),
+        exe_(exe),
+        progress_lines_(progress_lines),
         points_(expand_points(spec)) {}
 
   int run();

@@ -29,8 +29,7 @@ std::string value_text(const toml::node& v, const std::string& where) {
     std::string out = "[";
     for (std::size_t i = 0; i < a->size(); ++i) {
       const toml::node& x = *a->get(i);
-      if (!x.is_number())
-        throw ConfigError(fmt::format("{}: a list may only hold numbers", where));
+      if (!x.is_number()) throw ConfigError(fmt::format("{}: a list may only hold numbers", where));
       out += (i ? ", " : "") + value_text(x, where);
     }
     return out + "]";
@@ -187,9 +186,8 @@ void read_paired(const toml::node& node, const std::string& w, SweepSpec& spec) 
       const std::string wk = fmt::format("{}.\"{}\"", where, key);
       const auto* arr = kv.as_array();
       if (!arr || arr->size() != axis->second.size())
-        throw ConfigError(
-            fmt::format("{}: must be a list of {} values, one per entry of the axis", wk,
-                        axis->second.size()));
+        throw ConfigError(fmt::format("{}: must be a list of {} values, one per entry of the axis",
+                                      wk, axis->second.size()));
       const bool in_axes = std::any_of(spec.axes.begin(), spec.axes.end(),
                                        [&](const auto& a) { return a.first == key; });
       const bool in_set = std::any_of(spec.set.begin(), spec.set.end(),
