@@ -39,9 +39,9 @@ constexpr long kParts = 16;
 // error blocks of `per_block` parts (the last one takes the remainder): the correlation over
 // every origin and one with each block left out.
 struct JoinedSums {
-  std::vector<long> lag;                 // samples, lags that have pairs
-  std::vector<std::size_t> index;        // their index in the correlator
-  Eigen::RowVectorXd sum, count;         // over every origin
+  std::vector<long> lag;                   // samples, lags that have pairs
+  std::vector<std::size_t> index;          // their index in the correlator
+  Eigen::RowVectorXd sum, count;           // over every origin
   Eigen::MatrixXd block_sum, block_count;  // nb x lags
 };
 
@@ -139,10 +139,10 @@ DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sa
     while (m / static_cast<double>(1L << iv.level) >= 15.5) ++iv.level;
     iv.k = std::max(1L, std::lround(m / static_cast<double>(1L << iv.level)));
     if ((iv.k << iv.level) > msd_lag)
-      throw std::invalid_argument(fmt::format(
-          "analysis.velocity_intervals: {:g} is longer than the MSD's lags (analysis."
-          "msd_window_hi = {:g})",
-          delta, s.window_hi));
+      throw std::invalid_argument(
+          fmt::format("analysis.velocity_intervals: {:g} is longer than the MSD's lags (analysis."
+                      "msd_window_hi = {:g})",
+                      delta, s.window_hi));
     const double spacing = static_cast<double>(1L << iv.level) * dt_;
     iv.mini = std::max(1L, std::lround(s.error_block / kParts / spacing));
     const long lag = std::max(1L, static_cast<long>(std::ceil(s.vacf_max_lag / spacing - 1e-9)));
@@ -154,8 +154,9 @@ DiffusionAccumulator::DiffusionAccumulator(const DiffusionSettings& s, double sa
 void DiffusionAccumulator::add(const double* y, const double* vy, const double* x,
                                const std::uint8_t* bulk) {
   if ((x != nullptr) != x_ || (bulk != nullptr) != bulk_)
-    throw std::invalid_argument("DiffusionAccumulator: a sample without the x or bulk data the "
-                                "accumulator was made for");
+    throw std::invalid_argument(
+        "DiffusionAccumulator: a sample without the x or bulk data the "
+        "accumulator was made for");
   if (samples() % stride_ == 0) coarse_.add(y);
   const long n = samples();
   vacf_.add(vy, bulk);
@@ -186,30 +187,18 @@ void DiffusionAccumulator::serialize(Archive& a) {
   for (Interval& iv : intervals_) iv.c.serialize(a);
 }
 
-DiffusionReport DiffusionAccumulator::report() const {
-  DiffusionReport r;
-  r.sample_strain = dt_;
-  r.coarse_strain = static_cast<double>(stride_) * dt_;
-  r.samples = samples();
-  r.particles = particles_;
-  const long coarse = coarse_.samples();
-  if (r.samples < 4 || coarse < 4)
-    throw std::invalid_argument(fmt::format(
-        "diffusion analysis: {} samples ({} of them {:g} strain apart) of {} particles in the "
-        "measured window; at least 4 of each are needed (run longer after steady state)",
-        r.samples, coarse, r.coarse_strain, r.particles));
+// D: every origin of the coarse samples, lags up to the end of the fit window if the data
+// allow, else as far as they go.
+void DiffusionAccumulator::fit_msd(DiffusionReport& r) const {
   const double dtc = r.coarse_strain;
   const double measured = static_cast<double>(r.samples - 1) * dt_;
-
-  // D: every origin of the coarse samples, lags up to the end of the fit window if the data
-  // allow, else as far as they go.
   const long want = static_cast<long>(std::ceil(s_.window_hi / dtc - 1e-9)) + 1;
-  const long max_lag = std::min({want, coarse - 2, coarse_.band()});
+  const long max_lag = std::min({want, coarse_.samples() - 2, coarse_.band()});
   r.msd_coarse = coarse_.msd(dtc, max_lag);
   r.window_hi = std::min(s_.window_hi, static_cast<double>(max_lag) * dtc);
   // Only a window cut short by the data moves its start (to keep some points in it).
-  r.window_lo = r.window_hi < s_.window_hi ? std::min(s_.window_lo, 0.5 * r.window_hi)
-                                           : s_.window_lo;
+  r.window_lo =
+      r.window_hi < s_.window_hi ? std::min(s_.window_lo, 0.5 * r.window_hi) : s_.window_lo;
   if (r.window_hi < s_.window_hi)
     r.warnings.push_back(fmt::format(
         "the measured window ({:.3g} strains) is shorter than the MSD fit window [{:g}, {:g}]: "
@@ -220,20 +209,13 @@ DiffusionReport DiffusionAccumulator::report() const {
     r.warnings.push_back(
         fmt::format("the MSD is not diffusive in the fit window (log-log slope {:.3f}, 1 expected)",
                     r.fit.loglog_slope));
+}
 
-  const ErrorBlocks eb = error_blocks(r.samples, mini_);
-  const long block_samples = eb.block_samples, nb = eb.blocks;
-  r.error_block = static_cast<double>(block_samples) * dt_;
-  if (r.error_block < 0.99 * s_.error_block)
-    r.warnings.push_back(fmt::format(
-        "error bars from {} blocks of {:.3g} strain (analysis.error_block = {:g} would leave "
-        "fewer than 4 in the measured window)",
-        nb, r.error_block, s_.error_block));
-
-  const auto parts = static_cast<double>(particles_);
+// The sample-resolution MSD, dv, Psi and the step length, with what limits their resolution.
+void DiffusionAccumulator::velocities(DiffusionReport& r, long block_samples, long blocks) const {
   const long vacf_per_block = block_samples / vacf_.block();  // correlator blocks per block
-  r.msd = msd_from(join_blocks(msd_, 1, 1, false), dt_, parts);
-  r.vel = persistence_from(join_blocks(vacf_, vacf_per_block, nb, false), dt_);
+  r.msd = msd_from(join_blocks(msd_, 1, 1, false), dt_, static_cast<double>(particles_));
+  r.vel = persistence_from(join_blocks(vacf_, vacf_per_block, blocks, false), dt_);
   r.vacf = r.vel.c;
   r.persistence = r.vel.p;
   r.dv = r.vel.dv;
@@ -249,41 +231,49 @@ DiffusionReport DiffusionAccumulator::report() const {
         "error-bar blocks of {:.3g} strain are shorter than 10 Psi = {:.3g}: the errors may be "
         "underestimated (measure longer)",
         r.error_block, 10.0 * r.persistence.psi));
+}
 
-  // D's error bar from the same coarse samples, in blocks of the error-block length.
+// D's error bar from the same coarse samples, in blocks of the error-block length.
+void DiffusionAccumulator::d_error_bar(DiffusionReport& r) const {
   try {
-    const long bc = std::max(2L, std::lround(r.error_block / dtc));
-    r.d_error = msd_slope_error(coarse_, dtc, r.window_lo, r.window_hi, bc);
+    const long bc = std::max(2L, std::lround(r.error_block / r.coarse_strain));
+    r.d_error = msd_slope_error(coarse_, r.coarse_strain, r.window_lo, r.window_hi, bc);
   } catch (const std::invalid_argument& e) {
     r.d_error.d = r.d_error.err = std::nan("");
     r.warnings.push_back(fmt::format("no error bar for D: {}", e.what()));
   }
+}
 
-  if (bulk_) {
-    const JoinedSums m = join_blocks(msd_, 1, 1, true);
-    r.bulk_fraction = m.count.size() > 0 && m.count(0) > 0
-                          ? m.count(0) / (parts * static_cast<double>(r.samples))
-                          : 0.0;
-    if (r.bulk_fraction <= 0.0) {
-      r.warnings.push_back("no disc is ever in the bulk: no bulk-only analysis");
-    } else {
-      r.has_bulk = true;
-      r.msd_bulk = msd_from(m, dt_, parts);
-      try {
-        r.fit_bulk = fit_diffusion(r.msd_bulk, r.window_lo, r.window_hi);
-      } catch (const std::invalid_argument& e) {
-        r.fit_bulk.d = std::nan("");
-        r.warnings.push_back(fmt::format("no bulk D: {}", e.what()));
-      }
-      r.vel_bulk = persistence_from(join_blocks(vacf_, vacf_per_block, nb, true), dt_);
-    }
+void DiffusionAccumulator::bulk_only(DiffusionReport& r, long block_samples, long blocks) const {
+  const auto parts = static_cast<double>(particles_);
+  const JoinedSums m = join_blocks(msd_, 1, 1, true);
+  r.bulk_fraction = m.count.size() > 0 && m.count(0) > 0
+                        ? m.count(0) / (parts * static_cast<double>(r.samples))
+                        : 0.0;
+  if (r.bulk_fraction <= 0.0) {
+    r.warnings.push_back("no disc is ever in the bulk: no bulk-only analysis");
+    return;
   }
+  r.has_bulk = true;
+  r.msd_bulk = msd_from(m, dt_, parts);
+  try {
+    r.fit_bulk = fit_diffusion(r.msd_bulk, r.window_lo, r.window_hi);
+  } catch (const std::invalid_argument& e) {
+    r.fit_bulk.d = std::nan("");
+    r.warnings.push_back(fmt::format("no bulk D: {}", e.what()));
+  }
+  r.vel_bulk =
+      persistence_from(join_blocks(vacf_, block_samples / vacf_.block(), blocks, true), dt_);
+}
+
+void DiffusionAccumulator::interval_velocities(DiffusionReport& r) const {
   for (const Interval& iv : intervals_) {
     DiffusionReport::IntervalVelocity out;
     out.sample_strain = static_cast<double>(1L << iv.level) * dt_;
     out.interval = static_cast<double>(iv.k) * out.sample_strain;
     if (iv.c.samples() < 4) {
-      r.warnings.push_back(fmt::format("no velocity over {:g}: fewer than 4 samples", out.interval));
+      r.warnings.push_back(
+          fmt::format("no velocity over {:g}: fewer than 4 samples", out.interval));
       continue;
     }
     const ErrorBlocks b = error_blocks(iv.c.samples(), iv.mini);
@@ -291,16 +281,44 @@ DiffusionReport DiffusionAccumulator::report() const {
                                out.sample_strain);
     r.intervals.push_back(out);
   }
-  if (x_) {
-    r.has_x = true;
-    r.msd_x = msd_from(join_blocks(msd_x_, 1, 1, false), dt_, parts);
-    try {
-      r.fit_x = fit_diffusion(r.msd_x, r.window_lo, r.window_hi);
-    } catch (const std::invalid_argument& e) {
-      r.fit_x.d = r.fit_x.loglog_slope = std::nan("");
-      r.warnings.push_back(fmt::format("no x diffusion: {}", e.what()));
-    }
+}
+
+void DiffusionAccumulator::x_diffusion(DiffusionReport& r) const {
+  r.has_x = true;
+  r.msd_x = msd_from(join_blocks(msd_x_, 1, 1, false), dt_, static_cast<double>(particles_));
+  try {
+    r.fit_x = fit_diffusion(r.msd_x, r.window_lo, r.window_hi);
+  } catch (const std::invalid_argument& e) {
+    r.fit_x.d = r.fit_x.loglog_slope = std::nan("");
+    r.warnings.push_back(fmt::format("no x diffusion: {}", e.what()));
   }
+}
+
+DiffusionReport DiffusionAccumulator::report() const {
+  DiffusionReport r;
+  r.sample_strain = dt_;
+  r.coarse_strain = static_cast<double>(stride_) * dt_;
+  r.samples = samples();
+  r.particles = particles_;
+  const long coarse = coarse_.samples();
+  if (r.samples < 4 || coarse < 4)
+    throw std::invalid_argument(fmt::format(
+        "diffusion analysis: {} samples ({} of them {:g} strain apart) of {} particles in the "
+        "measured window; at least 4 of each are needed (run longer after steady state)",
+        r.samples, coarse, r.coarse_strain, r.particles));
+  fit_msd(r);
+  const ErrorBlocks eb = error_blocks(r.samples, mini_);
+  r.error_block = static_cast<double>(eb.block_samples) * dt_;
+  if (r.error_block < 0.99 * s_.error_block)
+    r.warnings.push_back(fmt::format(
+        "error bars from {} blocks of {:.3g} strain (analysis.error_block = {:g} would leave "
+        "fewer than 4 in the measured window)",
+        eb.blocks, r.error_block, s_.error_block));
+  velocities(r, eb.block_samples, eb.blocks);
+  d_error_bar(r);
+  if (bulk_) bulk_only(r, eb.block_samples, eb.blocks);
+  interval_velocities(r);
+  if (x_) x_diffusion(r);
   return r;
 }
 

@@ -93,6 +93,13 @@ class DiffusionAccumulator {
     long k = 1, mini = 1;
     MultipleTauCorrelator c;
   };
+  // The parts of report(), each filling its part of r.
+  void fit_msd(DiffusionReport& r) const;
+  void velocities(DiffusionReport& r, long block_samples, long blocks) const;
+  void d_error_bar(DiffusionReport& r) const;
+  void bulk_only(DiffusionReport& r, long block_samples, long blocks) const;
+  void interval_velocities(DiffusionReport& r) const;
+  void x_diffusion(DiffusionReport& r) const;
 
   DiffusionSettings s_;
   double dt_ = 0.0;
