@@ -3,7 +3,6 @@
 #include <fmt/core.h>
 
 #include <Eigen/Dense>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -116,19 +115,11 @@ PowerLawFit fit_power_law(const std::vector<double>& x, const std::vector<double
   return p;
 }
 
-DilatancyFit fit_dilatancy(const std::vector<double>& x, const std::vector<double>& phi) {
-  check_sizes("fit_dilatancy", x.size(), phi.size(), 4);
-  const std::vector<double> logx = logs("fit_dilatancy", "x", x);
-  for (std::size_t i = 0; i < phi.size(); ++i) {
-    if (!std::isfinite(phi[i])) {
-      throw std::invalid_argument(fmt::format("fit_dilatancy: phi[{}] is not finite", i));
-    }
-  }
-  if (*std::min_element(x.begin(), x.end()) == *std::max_element(x.begin(), x.end())) {
-    throw std::invalid_argument("fit_dilatancy: all x values are equal");
-  }
-  const double phi_max = *std::max_element(phi.begin(), phi.end());
+namespace {
 
+// The log of phi_c - max(phi) that best makes phi_c - phi a power law of x.
+double best_log_gap(const std::vector<double>& logx, const std::vector<double>& phi,
+                    double phi_max) {
   // (1) Search over u = log(phi_c - phi_max): the optimum can sit very close to max(phi) (a
   // small-x point with phi_c - phi ~ 1e-3), which a linear grid would resolve poorly. Gaps
   // below 1e-9 are not searched (far below any measurable phi).
@@ -142,8 +133,8 @@ DilatancyFit fit_dilatancy(const std::vector<double>& x, const std::vector<doubl
   constexpr int kGrid = 400;
   std::vector<double> grid_cost(kGrid);
   for (int j = 0; j < kGrid; ++j) grid_cost[j] = cost(u_lo + (u_hi - u_lo) * j / (kGrid - 1));
-  int best = static_cast<int>(std::min_element(grid_cost.begin(), grid_cost.end()) -
-                              grid_cost.begin());
+  int best =
+      static_cast<int>(std::min_element(grid_cost.begin(), grid_cost.end()) - grid_cost.begin());
   for (int j = 1; j + 1 < kGrid; ++j) {
     if (grid_cost[j] < grid_cost[j - 1] && grid_cost[j] <= grid_cost[j + 1]) {
       best = j;
@@ -176,27 +167,15 @@ DilatancyFit fit_dilatancy(const std::vector<double>& x, const std::vector<doubl
   double u_best = 0.5 * (a + b);
   // Keep the grid point if the refinement somehow did worse (flat or noisy objective).
   if (cost(u_best) > best_cost) u_best = u_lo + step * best;
+  return u_best;
+}
 
-  DilatancyFit fit;
-  fit.phi_c = phi_max + std::exp(u_best);
-
-  // (2) Power law of the gap at fixed phi_c.
-  std::vector<double> gap(phi.size());
-  for (std::size_t i = 0; i < phi.size(); ++i) gap[i] = fit.phi_c - phi[i];
-  fit.law = fit_power_law(x, gap);
-
-  // (3) Least-squares phi_c at fixed a, b: minimising sum (phi_c - a x^b - phi)^2 in phi_c gives
-  // the mean of phi + a x^b; its shift from (1) is the seed's error estimate.
-  double refit = 0;
-  for (std::size_t i = 0; i < phi.size(); ++i) {
-    refit += phi[i] + fit.law.a * std::pow(x[i], fit.law.b);
-  }
-  refit /= static_cast<double>(phi.size());
-  fit.phi_c_err = std::abs(refit - fit.phi_c);
-
+// Joint standard errors of (phi_c, a, b) into fit, from the linearised covariance.
+void joint_errors(DilatancyFit& fit, const std::vector<double>& logx,
+                  const std::vector<double>& gap) {
   // Joint covariance of (phi_c, log a, b) for the residual r_i = log(phi_c - phi_i) - log a -
   // b log x_i, linearised at the optimum.
-  const std::size_t m = phi.size();
+  const std::size_t m = gap.size();
   Eigen::MatrixXd jac(static_cast<Eigen::Index>(m), 3);
   double ssr = 0;
   const double log_a = std::log(fit.law.a);
@@ -220,6 +199,42 @@ DilatancyFit fit_dilatancy(const std::vector<double>& x, const std::vector<doubl
     fit.phi_c_stderr = fit.a_stderr_joint = fit.b_stderr_joint =
         std::numeric_limits<double>::quiet_NaN();
   }
+}
+
+}  // namespace
+
+DilatancyFit fit_dilatancy(const std::vector<double>& x, const std::vector<double>& phi) {
+  check_sizes("fit_dilatancy", x.size(), phi.size(), 4);
+  const std::vector<double> logx = logs("fit_dilatancy", "x", x);
+  for (std::size_t i = 0; i < phi.size(); ++i) {
+    if (!std::isfinite(phi[i])) {
+      throw std::invalid_argument(fmt::format("fit_dilatancy: phi[{}] is not finite", i));
+    }
+  }
+  if (*std::min_element(x.begin(), x.end()) == *std::max_element(x.begin(), x.end())) {
+    throw std::invalid_argument("fit_dilatancy: all x values are equal");
+  }
+  const double phi_max = *std::max_element(phi.begin(), phi.end());
+
+  // (1) phi_c, searched above max(phi).
+  DilatancyFit fit;
+  fit.phi_c = phi_max + std::exp(best_log_gap(logx, phi, phi_max));
+
+  // (2) Power law of the gap at fixed phi_c.
+  std::vector<double> gap(phi.size());
+  for (std::size_t i = 0; i < phi.size(); ++i) gap[i] = fit.phi_c - phi[i];
+  fit.law = fit_power_law(x, gap);
+
+  // (3) Least-squares phi_c at fixed a, b: minimising sum (phi_c - a x^b - phi)^2 in phi_c gives
+  // the mean of phi + a x^b; its shift from (1) is the seed's error estimate.
+  double refit = 0;
+  for (std::size_t i = 0; i < phi.size(); ++i) {
+    refit += phi[i] + fit.law.a * std::pow(x[i], fit.law.b);
+  }
+  refit /= static_cast<double>(phi.size());
+  fit.phi_c_err = std::abs(refit - fit.phi_c);
+
+  joint_errors(fit, logx, gap);
   return fit;
 }
 
