@@ -587,52 +587,47 @@ std::string group_identity(const Config& c) {
 
 }  // namespace
 
-json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
-                bool include_drifting) {
-  if (stores.empty()) throw ConfigError("fit: give at least one store");
-  if (fs::exists(out_dir / "points") ||
-      (fs::exists(out_dir / "fits.json") && !fs::exists(out_dir / "fit_sources.txt")))
-    throw ConfigError(fmt::format(
-        "fit --out {}: that folder holds a sweep or a store, whose sweep.csv and fits.json this "
-        "would replace; give a folder of its own",
-        out_dir.string()));
-  std::vector<std::map<std::string, json>> table;
+namespace {
+
+// A store's finished points that measured a J, sorted by folder name.
+std::vector<std::pair<fs::path, json>> store_summaries(const fs::path& store) {
+  if (!fs::is_directory(store / "points"))
+    throw ConfigError(
+        fmt::format("fit: {}: not a store or sweep folder (no points/)", store.string()));
+  std::vector<fs::path> dirs;
+  for (const auto& e : fs::directory_iterator(store / "points"))
+    if (fs::exists(e.path() / "summary.json") && fs::exists(e.path() / "config.toml"))
+      dirs.push_back(e.path());
+  std::sort(dirs.begin(), dirs.end());
+  std::vector<std::pair<fs::path, json>> here;
+  for (const auto& dir : dirs) {
+    std::ifstream in(dir / "summary.json");
+    json summary;
+    try {
+      summary = json::parse(in);
+    } catch (const json::exception& e) {
+      throw ConfigError(fmt::format("fit: {}: not a valid summary: {}",
+                                    (dir / "summary.json").string(), e.what()));
+    }
+    if (!summary.contains("J") || !summary["J"].is_number()) continue;
+    here.emplace_back(dir, std::move(summary));
+  }
+  return here;
+}
+
+// Points of several stores combined into one group: each J from the first store that holds it.
+struct Combination {
+  bool include_drifting = false;
+  std::vector<Row> table;
   std::set<std::string> summary_keys;
   std::map<double, std::vector<json>> by_j;
   std::map<double, std::string> j_from;  // each J's store
   std::string identity, identity_of;
   long used = 0;
-  // Stores are named relative to the output folder, so that a committed fit names no path
-  // outside the repository and still finds its points from anywhere.
-  fs::create_directories(out_dir);
-  const auto relative_name = [&](const fs::path& store) {
-    return fs::relative(fs::weakly_canonical(store), fs::weakly_canonical(out_dir)).string();
-  };
-  for (const auto& store : stores) {
-    if (!fs::is_directory(store / "points"))
-      throw ConfigError(
-          fmt::format("fit: {}: not a store or sweep folder (no points/)", store.string()));
-    std::vector<fs::path> dirs;
-    for (const auto& e : fs::directory_iterator(store / "points"))
-      if (fs::exists(e.path() / "summary.json") && fs::exists(e.path() / "config.toml"))
-        dirs.push_back(e.path());
-    std::sort(dirs.begin(), dirs.end());
+
+  void add(const fs::path& store, const std::string& store_name) {
     std::set<double> js_here;
-    std::vector<std::pair<fs::path, json>> here;
-    for (const auto& dir : dirs) {
-      std::ifstream in(dir / "summary.json");
-      json summary;
-      try {
-        summary = json::parse(in);
-      } catch (const json::exception& e) {
-        throw ConfigError(fmt::format("fit: {}: not a valid summary: {}",
-                                      (dir / "summary.json").string(), e.what()));
-      }
-      if (!summary.contains("J") || !summary["J"].is_number()) continue;
-      js_here.insert(summary["J"].get<double>());
-      here.emplace_back(dir, std::move(summary));
-    }
-    for (auto& [dir, summary] : here) {
+    for (auto& [dir, summary] : store_summaries(store)) {
       const Config cfg = load_config(dir / "config.toml");
       const std::string id = group_identity(cfg);
       const std::string name =
@@ -644,9 +639,10 @@ json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
             "fit: {} ({}) and {} ({}) are not one group: fit stores of the same physics", name, id,
             identity_of, identity));
       const double j = summary["J"].get<double>();
-      std::map<std::string, json> row;
+      js_here.insert(j);
+      Row row;
       row["point"] = name;
-      row["store"] = relative_name(store);
+      row["store"] = store_name;
       std::string status = "done";
       if (const auto it = j_from.find(j); it != j_from.end())
         status = "replaced by " + it->second;
@@ -655,10 +651,7 @@ json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
       row["status"] = status;
       std::map<std::string, json> flat;
       flatten(summary, flat);
-      for (auto& [k, v] : flat) {
-        summary_keys.insert(k);
-        row[k] = v;
-      }
+      for (auto& [k, v] : flat) summary_keys.insert(k), row[k] = v;
       // On request, windows flagged by the stationarity test enter the fits too (a check of
       // how much the flagged points move them); replaced and unsteady points never do.
       const bool flagged = status == "done, not stationary" || status.starts_with("done, drifting");
@@ -668,27 +661,49 @@ json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
       }
       table.push_back(std::move(row));
     }
-    for (double j : js_here) j_from.emplace(j, relative_name(store));
+    for (double j : js_here) j_from.emplace(j, store_name);
   }
+};
+
+}  // namespace
+
+json fit_stores(const std::vector<fs::path>& stores, const fs::path& out_dir,
+                bool include_drifting) {
+  if (stores.empty()) throw ConfigError("fit: give at least one store");
+  if (fs::exists(out_dir / "points") ||
+      (fs::exists(out_dir / "fits.json") && !fs::exists(out_dir / "fit_sources.txt")))
+    throw ConfigError(fmt::format(
+        "fit --out {}: that folder holds a sweep or a store, whose sweep.csv and fits.json this "
+        "would replace; give a folder of its own",
+        out_dir.string()));
+  // Stores are named relative to the output folder, so that a committed fit names no path
+  // outside the repository and still finds its points from anywhere.
+  fs::create_directories(out_dir);
+  const auto relative_name = [&](const fs::path& store) {
+    return fs::relative(fs::weakly_canonical(store), fs::weakly_canonical(out_dir)).string();
+  };
+  Combination c;
+  c.include_drifting = include_drifting;
+  for (const auto& store : stores) c.add(store, relative_name(store));
   std::vector<std::string> columns = {"point", "status", "store"};
-  columns.insert(columns.end(), summary_keys.begin(), summary_keys.end());
+  columns.insert(columns.end(), c.summary_keys.begin(), c.summary_keys.end());
 
   json fits;
   fits["sweep"] = "combined";
   fits["includes_not_stationary"] = include_drifting;
   fits["stores"] = json::array();
   for (const auto& st : stores) fits["stores"].push_back(relative_name(st));
-  fits["points"] = table.size();
-  fits["finished"] = used;
+  fits["points"] = c.table.size();
+  fits["finished"] = c.used;
   fits["seed_table1"] = seed_reference();
   fits["groups"] = json::array();
-  if (!by_j.empty()) fits["groups"].push_back(fits_of_group(by_j, json::object()));
+  if (!c.by_j.empty()) fits["groups"].push_back(fits_of_group(c.by_j, json::object()));
   std::string sources =
       "Fitted by `sheardiff fit` from (relative to this folder; each J from the first that holds "
       "it):\n";
   for (const auto& st : stores) sources += relative_name(st) + "\n";
   write_file_atomically(out_dir / "fit_sources.txt", sources);
-  write_file_atomically(out_dir / "sweep.csv", csv_text(columns, table));
+  write_file_atomically(out_dir / "sweep.csv", csv_text(columns, c.table));
   write_file_atomically(out_dir / "fits.json", json_text(fits) + "\n");
   return fits;
 }
