@@ -221,7 +221,6 @@ std::string refusal(const RunDirectory& dir) {
 
 }  // namespace
 
-
 nlohmann::json run_to_directory(const Config& cfg, const std::filesystem::path& out_dir,
                                 bool progress, bool resume) {
   RunDirectory dir(out_dir, !resume);
@@ -372,6 +371,116 @@ std::int64_t unix_seconds_now() {
 }  // namespace
 
 // A function-try-block: every failure of the run passes the handlers at the end.
+namespace {
+
+// Where a run's step loop sends what it produces: checkpoints, frames, progress lines; and how
+// it stops (a signal, an unhealthy state) with a checkpoint.
+class StepLoop {
+ public:
+  StepLoop(const Config& cfg, RunningState& run, RunDirectory& dir,
+           const CheckpointStore& checkpoints, TrajectoryOutput& trajectory, RunProgress& progress)
+      : cfg_(cfg),
+        run_(run),
+        dir_(dir),
+        checkpoints_(checkpoints),
+        trajectory_(trajectory),
+        progress_(progress) {}
+
+  void run_to_the_end() {
+    Simulation& sim = run_.sim;
+    Dynamics& d = sim.dynamics();
+    while (!run_.finished(cfg_)) {
+      if (const int sig = g_stop_signal.load()) stop_on_signal(sig);
+      if (!sim.try_step()) stop(run_.health.solver_failure(d, sim.integrator().velocities()));
+      if (auto r = run_.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+        stop(*r);
+      const StressSample s = sim.sample();
+      const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
+      for (const auto& o : run_.observers) o->on_step(view);
+      if (d.strain() >= run_.next_frame * (1.0 - 1e-12)) output_frame(view);
+      progress_.update(cfg_, run_);
+      trajectory_.flush_now_and_then();
+    }
+    // The last move may have used up the skin: check it against a fresh neighbour list.
+    if (d.neighbours().needs_rebuild()) {
+      d.rebuild_now();
+      if (auto r = run_.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
+        stop(*r);
+    }
+    progress_.end_line();
+  }
+
+ private:
+  // A frame: observers add their values, the trajectory writes it, a checkpoint may follow.
+  void output_frame(const StepView& view) {
+    const Dynamics& d = run_.sim.dynamics();
+    run_.next_frame = next_output_strain(run_.next_frame, cfg_.output.frame_strain, d.strain());
+    values_.clear();
+    for (const auto& o : run_.observers) o->on_frame(view, values_);
+    trajectory_.write_frame(cfg_, run_, values_);
+    ++run_.frames;
+    if (cfg_.output.checkpoint_strain > 0.0 && d.strain() >= run_.next_checkpoint * (1.0 - 1e-12)) {
+      run_.next_checkpoint =
+          next_output_strain(run_.next_checkpoint, cfg_.output.checkpoint_strain, d.strain());
+      checkpoints_.save(run_, progress_.elapsed(), trajectory_);
+    }
+  }
+
+  [[noreturn]] void stop_on_signal(int sig) {
+    const Dynamics& d = run_.sim.dynamics();
+    checkpoints_.save(run_, progress_.elapsed(), trajectory_);
+    progress_.end_line();
+    throw RunInterrupted(sig, fmt::format("stopped by signal {} at step {} (strain {:.6g}); "
+                                          "checkpoint written: resume with `sheardiff run "
+                                          "CONFIG --resume {}`",
+                                          sig, d.steps(), d.strain(), dir_.path().string()));
+  }
+
+  // A run gone wrong stops with a checkpoint if its state is finite (else the last one is
+  // kept) and a diagnostic frame.
+  [[noreturn]] void stop(const HealthReport& r) {
+    if (r.state_finite) checkpoints_.save(run_, progress_.elapsed(), trajectory_);
+    write_diagnostic(dir_.file("diagnostic.txt"), run_.sim.dynamics(),
+                     run_.sim.integrator().velocities(), r);
+    progress_.end_line();
+    throw RunUnhealthy(r);
+  }
+
+  const Config& cfg_;
+  RunningState& run_;
+  RunDirectory& dir_;
+  const CheckpointStore& checkpoints_;
+  TrajectoryOutput& trajectory_;
+  RunProgress& progress_;
+  std::vector<double> values_;
+};
+
+// Once the run has taken charge of the directory (its log started), a failure to write leaves
+// it resumable: the last checkpoint whole (it is never half-written), no FILE.tmp, and the user
+// told how to go on.
+[[noreturn]] void rethrow_with_advice(RunDirectory& dir, const IoError& e) {
+  dir.remove_partial_files();
+  const std::string out = dir.path().string();
+  if (dir.moved())
+    throw IoError(fmt::format(
+        "{}. {} was moved or removed while the run ran; {}", e.what(), out,
+        dir.state() == RunState::interrupted
+            ? "its checkpoint.bin went with it: continue with `sheardiff run CONFIG --resume "
+              "NEWDIR` where it is now"
+            : "no checkpoint had been written: start the run again"));
+  throw IoError(fmt::format(
+      "{}. {}", e.what(),
+      dir.state() == RunState::interrupted
+          ? fmt::format("{} is intact: once the cause is fixed, continue with `sheardiff run "
+                        "CONFIG --resume {}`",
+                        dir.file("checkpoint.bin").string(), out)
+          : fmt::format("No checkpoint was written yet: once the cause is fixed, `sheardiff run "
+                        "CONFIG --resume {}` starts the run again",
+                        out)));
+}
+
+}  // namespace
+
 nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode, bool progress,
                                 double progress_seconds) try {
   // From here SIGINT/SIGTERM only set a flag: a signal during the set-up (minutes for a large
@@ -395,79 +504,11 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   claim_directory(dir, mode, from_checkpoint, checksummed, resolved);
   TrajectoryOutput trajectory(cfg, run, dir, resolved, from_checkpoint);
   RunProgress progress_lines(dir, progress, progress_seconds, run.sim.dynamics());
-
-  Simulation& sim = run.sim;
-  Dynamics& d = sim.dynamics();
-  // A run gone wrong stops with a checkpoint if its state is finite (else the last one is
-  // kept) and a diagnostic frame.
-  const auto stop = [&](const HealthReport& r) {
-    if (r.state_finite) checkpoints.save(run, progress_lines.elapsed(), trajectory);
-    write_diagnostic(dir.file("diagnostic.txt"), d, sim.integrator().velocities(), r);
-    progress_lines.end_line();
-    throw RunUnhealthy(r);
-  };
-  std::vector<double> values;
-  while (!run.finished(cfg)) {
-    if (const int sig = g_stop_signal.load()) {
-      checkpoints.save(run, progress_lines.elapsed(), trajectory);
-      progress_lines.end_line();
-      throw RunInterrupted(sig, fmt::format("stopped by signal {} at step {} (strain {:.6g}); "
-                                            "checkpoint written: resume with `sheardiff run "
-                                            "CONFIG --resume {}`",
-                                            sig, d.steps(), d.strain(), dir.path().string()));
-    }
-    if (!sim.try_step()) stop(run.health.solver_failure(d, sim.integrator().velocities()));
-    if (auto r = run.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
-      stop(*r);
-    const StressSample s = sim.sample();
-    const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
-    for (const auto& o : run.observers) o->on_step(view);
-    if (d.strain() >= run.next_frame * (1.0 - 1e-12)) {
-      run.next_frame = next_output_strain(run.next_frame, cfg.output.frame_strain, d.strain());
-      values.clear();
-      for (const auto& o : run.observers) o->on_frame(view, values);
-      trajectory.write_frame(cfg, run, values);
-      ++run.frames;
-      if (cfg.output.checkpoint_strain > 0.0 && d.strain() >= run.next_checkpoint * (1.0 - 1e-12)) {
-        run.next_checkpoint =
-            next_output_strain(run.next_checkpoint, cfg.output.checkpoint_strain, d.strain());
-        checkpoints.save(run, progress_lines.elapsed(), trajectory);
-      }
-    }
-    progress_lines.update(cfg, run);
-    trajectory.flush_now_and_then();
-  }
-  // The last move may have used up the skin: check it against a fresh neighbour list.
-  if (d.neighbours().needs_rebuild()) {
-    d.rebuild_now();
-    if (auto r = run.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
-      stop(*r);
-  }
-  progress_lines.end_line();
+  StepLoop(cfg, run, dir, checkpoints, trajectory, progress_lines).run_to_the_end();
   return finish_run(cfg, run, run.elapsed_before + progress_lines.elapsed(), dir, trajectory);
 } catch (const IoError& e) {
-  // Once the run has taken charge of the directory (its log started), a failure leaves it
-  // resumable: the last checkpoint whole (it is never half-written), no FILE.tmp, and the user
-  // told how to go on.
   if (!dir.logging()) throw;
-  dir.remove_partial_files();
-  const std::string out = dir.path().string();
-  if (dir.moved())
-    throw IoError(fmt::format(
-        "{}. {} was moved or removed while the run ran; {}", e.what(), out,
-        dir.state() == RunState::interrupted
-            ? "its checkpoint.bin went with it: continue with `sheardiff run CONFIG --resume "
-              "NEWDIR` where it is now"
-            : "no checkpoint had been written: start the run again"));
-  throw IoError(fmt::format(
-      "{}. {}", e.what(),
-      dir.state() == RunState::interrupted
-          ? fmt::format("{} is intact: once the cause is fixed, continue with `sheardiff run "
-                        "CONFIG --resume {}`",
-                        dir.file("checkpoint.bin").string(), out)
-          : fmt::format("No checkpoint was written yet: once the cause is fixed, `sheardiff run "
-                        "CONFIG --resume {}` starts the run again",
-                        out)));
+  rethrow_with_advice(dir, e);
 } catch (...) {
   if (dir.logging()) dir.remove_partial_files();
   throw;
