@@ -36,41 +36,44 @@ namespace {
 constexpr int kExitIo = 1;
 constexpr int kExitConfig = 2;
 constexpr int kExitNumerical = 3;
+// `sweep FILE --point I`: one point in this process (a worker of the pool or a Slurm task).
+int sweep_point(const sheardiff::SweepSpec& spec, const std::filesystem::path& out, long point) {
+  namespace sd = sheardiff;
+  const auto points = sd::expand_points(spec);
+  if (point >= static_cast<long>(points.size()))
+    throw sd::ConfigError(
+        fmt::format("--point {}: the sweep has points 0 to {}", point, points.size() - 1));
+  const auto& p = points[point];
+  // A failure is recorded next to the log, so that sweep.csv can say which point failed how.
+  const auto marker = out / "logs" / (p.name + ".failed");
+  std::filesystem::create_directories(out / "logs");
+  std::filesystem::remove(marker);
+  try {
+    // The point's result, as `run` prints it: into the pool's logs/<point>.log (this worker's
+    // output) and the point's run.log.
+    sd::run_point(spec, p, out, [&](const sd::RunDirectory&, const nlohmann::json& summary) {
+      const std::string dir = sd::point_dir(out, p).string();
+      fmt::print("{}{}", sd::run_result_first_line(summary, dir), sd::run_result_details(summary));
+      sd::print_warnings(summary);
+      std::fflush(stdout);
+    });
+    return 0;
+  } catch (const sd::PointBusy&) {
+    throw;  // not a failure of the point: no marker
+  } catch (const sd::RunInterrupted&) {
+    throw;
+  } catch (const std::exception& e) {
+    sd::write_file_atomically(marker, fmt::format("{}\n", e.what()));
+    throw;
+  }
+}
+
 int run_sweep(const std::string& file, const std::filesystem::path& out, int jobs,
               std::string backend, long point, bool collect_only, bool quiet) {
   namespace sd = sheardiff;
   const auto spec = sd::load_sweep(file);
   if (backend.empty()) backend = spec.backend;
-  if (point >= 0) {
-    const auto points = sd::expand_points(spec);
-    if (point >= static_cast<long>(points.size()))
-      throw sd::ConfigError(
-          fmt::format("--point {}: the sweep has points 0 to {}", point, points.size() - 1));
-    const auto& p = points[point];
-    // A failure is recorded next to the log, so that sweep.csv can say which point failed how.
-    const auto marker = out / "logs" / (p.name + ".failed");
-    std::filesystem::create_directories(out / "logs");
-    std::filesystem::remove(marker);
-    try {
-      // The point's result, as `run` prints it: into the pool's logs/<point>.log (this worker's
-      // output) and the point's run.log.
-      sd::run_point(spec, p, out, [&](const sd::RunDirectory&, const nlohmann::json& summary) {
-        const std::string dir = sd::point_dir(out, p).string();
-        fmt::print("{}{}", sd::run_result_first_line(summary, dir),
-                   sd::run_result_details(summary));
-        sd::print_warnings(summary);
-        std::fflush(stdout);
-      });
-      return 0;
-    } catch (const sd::PointBusy&) {
-      throw;  // not a failure of the point: no marker
-    } catch (const sd::RunInterrupted&) {
-      throw;
-    } catch (const std::exception& e) {
-      sd::write_file_atomically(marker, fmt::format("{}\n", e.what()));
-      throw;
-    }
-  }
+  if (point >= 0) return sweep_point(spec, out, point);
   int failed = 0;
   if (!collect_only) {
     const auto exe = std::filesystem::read_symlink("/proc/self/exe");
@@ -149,6 +152,11 @@ const CLI::Validator kPositiveFinite(
 // Every subcommand and option of the command line.
 struct CommandLine {
   CommandLine();
+  void add_run();
+  void add_check_and_doc();
+  void add_analyse();
+  void add_sweep();
+  void add_fit();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
   CLI::App *run, *check, *doc, *analyse, *sweep, *fit;
   std::string config_path, out_dir = "out", resume_dir, run_dir, sweep_file, backend;
@@ -164,7 +172,14 @@ CommandLine::CommandLine() {
   app.require_subcommand(1);
   app.set_version_flag("--version", sheardiff::version_line(),
                        "Print the version and git commit, and exit");
+  add_run();
+  add_check_and_doc();
+  add_analyse();
+  add_sweep();
+  add_fit();
+}
 
+void CommandLine::add_run() {
   run = app.add_subcommand("run", "Run a configuration to its end");
   run->add_option("config", config_path, "Configuration file (TOML, see docs/config.md)")
       ->required();
@@ -195,7 +210,9 @@ CommandLine::CommandLine() {
                   "to DIR/run.log")
       ->capture_default_str()
       ->check(kPositiveFinite);
+}
 
+void CommandLine::add_check_and_doc() {
   check = app.add_subcommand("check", "Validate a configuration and print it resolved");
   check->add_option("config", config_path, "Configuration file (TOML)")->required();
   check->add_option("--set", overrides, "Override one key, section.key=value (repeatable)");
@@ -206,7 +223,9 @@ CommandLine::CommandLine() {
       "TOML file of the defaults (lines of at most 100 columns)");
   doc->add_flag("--markdown", markdown,
                 "Print the Markdown table instead (the one docs/config.md is made from)");
+}
 
+void CommandLine::add_analyse() {
   analyse = app.add_subcommand(
       "analyse",
       "Recompute the analysis (MSD, D, dv, VACF, Psi; the pressure cell's error bars and "
@@ -217,7 +236,9 @@ CommandLine::CommandLine() {
   analyse->add_option("--set", overrides,
                       "Analyse the same frames with another setting, analysis.KEY=value or "
                       "observables.KEY=value (repeatable), e.g. --set analysis.msd_window_lo=4");
+}
 
+void CommandLine::add_sweep() {
   sweep = app.add_subcommand(
       "sweep",
       "Run every point of a sweep file (axes over J, ktilde, N, seeds, ...) as its own "
@@ -236,7 +257,9 @@ CommandLine::CommandLine() {
                   "fits.json (what the Slurm collect job does)");
   sweep->add_flag("-q,--quiet", quiet,
                   "No progress lines; failures and the result's first line are still printed");
+}
 
+void CommandLine::add_fit() {
   fit = app.add_subcommand(
       "fit",
       "Fit the seed's laws over the finished points of several stores or sweep folders as one "

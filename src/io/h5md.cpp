@@ -1038,6 +1038,91 @@ long count_h5md_frames(const fs::path& file) {
   return count_frames(r, particle_group(r));
 }
 
+namespace {
+
+// The box of frame idx: y periodic or not, and the edges (cuboid or triclinic with edge vectors
+// (lx, 0) and (xy, ly), time-dependent or not) where the file has them.
+void read_box(const Reader& r, const std::string& g, hsize_t idx, H5mdFrame& out) {
+  const fs::path& file = r.path();
+  const std::string box = g + "/box";
+  if (!r.exists(box)) fail(file, box, "object not found");
+  const auto boundary = r.string_attr(box, "boundary");
+  if (boundary.size() < 2) fail(file, box + "@boundary", "expected 2 or 3 entries");
+  out.periodic_y = boundary[1] == "periodic";
+  const std::string edges_name = box + "/edges";
+  if (!r.exists(edges_name)) return;
+  std::vector<hsize_t> inner;
+  std::vector<double> e;
+  std::string where = edges_name;
+  if (r.is_group(edges_name)) {  // time-dependent
+    where += "/value";
+    e = r.read_rows<double>(where, H5T_NATIVE_DOUBLE, idx, 1, &inner);
+  } else {
+    e = r.read_all<double>(where, H5T_NATIVE_DOUBLE, &inner);
+    inner = r.dims(where);
+  }
+  const hsize_t dim = inner.empty() ? 0 : inner[0];
+  if (dim != 2 && dim != 3) fail(file, where, "expected the edges of a 2D or 3D box");
+  if (inner.size() == 1) {  // cuboid: the space diagonal
+    out.lx = e[0];
+    out.ly = e[1];
+  } else if (inner.size() == 2 && inner[1] == dim) {  // triclinic: edge vectors as rows
+    out.lx = e[0];
+    out.tilt = e[dim];
+    out.ly = e[dim + 1];
+    if (e[1] != 0.0)
+      fail(file, where,
+           fmt::format("the first edge vector ({}, {}) is not along x: only boxes with edges "
+                       "(lx, 0) and (xy, ly) (LAMMPS, GSD) can be read",
+                       e[0], e[1]));
+  } else {
+    fail(file, where, fmt::format("unexpected shape ({})", fmt::join(inner, ", ")));
+  }
+}
+
+// Velocities (x, y) and angular velocities (z) of frame idx, where the file has either.
+void read_velocities(const Reader& r, const std::string& g, hsize_t idx, hsize_t n,
+                     H5mdFrame& out) {
+  const std::string vel_name = g + "/velocity/value";
+  const std::string omega_name = g + "/angular_velocity/value";
+  const bool has_vel = r.exists(vel_name);
+  const bool has_omega = r.exists(omega_name);
+  if (!has_vel && !has_omega) return;
+  out.velocity.assign(n, Vec3::Zero());
+  if (has_vel) {
+    const auto v = read_vectors(r, vel_name, idx, n);
+    for (std::size_t i = 0; i < n; ++i) out.velocity[i].head<2>() = v[i];
+  }
+  if (has_omega) {
+    std::vector<hsize_t> inner;
+    const auto w = r.read_rows<double>(omega_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
+    expect_shape(r, omega_name, inner, {n});
+    for (std::size_t i = 0; i < n; ++i) out.velocity[i].z() = w[i];
+  }
+}
+
+// One value per particle (diameter, species, motion), time-independent or not. Optional, so
+// that files from other H5MD writers still load.
+template <class T>
+void read_per_particle(const Reader& r, const std::string& g, const char* rel, hid_t mem_type,
+                       hsize_t idx, hsize_t n, std::vector<T>& dest) {
+  std::string name = g + "/" + rel;
+  if (!r.exists(name)) return;
+  std::vector<hsize_t> inner;
+  if (r.is_group(name)) {
+    name += "/value";
+    dest = r.read_rows<T>(name, mem_type, idx, 1, &inner);
+  } else {
+    dest = r.read_all<T>(name, mem_type, &inner);
+    inner.clear();
+  }
+  expect_shape(r, name, inner, {});
+  if (dest.size() != n)
+    fail(r.path(), name, fmt::format("{} entries, position has {}", dest.size(), n));
+}
+
+}  // namespace
+
 H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
   const Reader r(file);
   const std::string g = particle_group(r);
@@ -1050,85 +1135,13 @@ H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
       static_cast<long>(axis_value<std::int64_t>(r, g + "/position/step", H5T_NATIVE_INT64, idx));
   if (r.exists(g + "/position/time"))
     out.time = axis_value<double>(r, g + "/position/time", H5T_NATIVE_DOUBLE, idx);
-
-  const std::string box = g + "/box";
-  if (!r.exists(box)) fail(file, box, "object not found");
-  const auto boundary = r.string_attr(box, "boundary");
-  if (boundary.size() < 2) fail(file, box + "@boundary", "expected 2 or 3 entries");
-  out.periodic_y = boundary[1] == "periodic";
-  const std::string edges_name = box + "/edges";
-  if (r.exists(edges_name)) {
-    std::vector<hsize_t> inner;
-    std::vector<double> e;
-    std::string where = edges_name;
-    if (r.is_group(edges_name)) {  // time-dependent
-      where += "/value";
-      e = r.read_rows<double>(where, H5T_NATIVE_DOUBLE, idx, 1, &inner);
-    } else {
-      e = r.read_all<double>(where, H5T_NATIVE_DOUBLE, &inner);
-      inner = r.dims(where);
-    }
-    const hsize_t dim = inner.empty() ? 0 : inner[0];
-    if (dim != 2 && dim != 3) fail(file, where, "expected the edges of a 2D or 3D box");
-    if (inner.size() == 1) {  // cuboid: the space diagonal
-      out.lx = e[0];
-      out.ly = e[1];
-    } else if (inner.size() == 2 && inner[1] == dim) {  // triclinic: edge vectors as rows
-      out.lx = e[0];
-      out.tilt = e[dim];
-      out.ly = e[dim + 1];
-      if (e[1] != 0.0)
-        fail(file, where,
-             fmt::format("the first edge vector ({}, {}) is not along x: only boxes with edges "
-                         "(lx, 0) and (xy, ly) (LAMMPS, GSD) can be read",
-                         e[0], e[1]));
-    } else {
-      fail(file, where, fmt::format("unexpected shape ({})", fmt::join(inner, ", ")));
-    }
-  }
-
+  read_box(r, g, idx, out);
   const std::string unwrapped_name = g + "/unwrapped_position/value";
   if (r.exists(unwrapped_name)) out.unwrapped = read_vectors(r, unwrapped_name, idx, n);
-
-  const std::string vel_name = g + "/velocity/value";
-  const std::string omega_name = g + "/angular_velocity/value";
-  const bool has_vel = r.exists(vel_name);
-  const bool has_omega = r.exists(omega_name);
-  if (has_vel || has_omega) {
-    out.velocity.assign(n, Vec3::Zero());
-    if (has_vel) {
-      const auto v = read_vectors(r, vel_name, idx, n);
-      for (std::size_t i = 0; i < n; ++i) out.velocity[i].head<2>() = v[i];
-    }
-    if (has_omega) {
-      std::vector<hsize_t> inner;
-      const auto w = r.read_rows<double>(omega_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
-      expect_shape(r, omega_name, inner, {n});
-      for (std::size_t i = 0; i < n; ++i) out.velocity[i].z() = w[i];
-    }
-  }
-
-  // Optional so files from other H5MD writers still load; time-independent or not.
-  const auto per_particle = [&](const char* rel, hid_t mem_type, auto& dest) {
-    std::string name = g + "/" + rel;
-    if (!r.exists(name)) return;
-    using T = typename std::decay_t<decltype(dest)>::value_type;
-    std::vector<hsize_t> inner;
-    if (r.is_group(name)) {
-      name += "/value";
-      dest = r.read_rows<T>(name, mem_type, idx, 1, &inner);
-    } else {
-      dest = r.read_all<T>(name, mem_type, &inner);
-      inner.clear();
-    }
-    expect_shape(r, name, inner, {});
-    if (dest.size() != n) {
-      fail(file, name, fmt::format("{} entries, position has {}", dest.size(), n));
-    }
-  };
-  per_particle("diameter", H5T_NATIVE_DOUBLE, out.diameter);
-  per_particle("species", H5T_NATIVE_INT, out.species);
-  per_particle("motion", H5T_NATIVE_INT, out.motion);
+  read_velocities(r, g, idx, n, out);
+  read_per_particle(r, g, "diameter", H5T_NATIVE_DOUBLE, idx, n, out.diameter);
+  read_per_particle(r, g, "species", H5T_NATIVE_INT, idx, n, out.species);
+  read_per_particle(r, g, "motion", H5T_NATIVE_INT, idx, n, out.motion);
   return out;
 }
 

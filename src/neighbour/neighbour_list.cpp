@@ -39,10 +39,12 @@ std::uint64_t pair_key(int i, int j) {
 
 }  // namespace
 
-void NeighbourList::rebuild(Particles& p, const Box& box) {
+namespace {
+
+// Wrap into the primary cell; a Lees-Edwards crossing in y shifts x by the offset. The images
+// crossed are counted, so that the trajectory's position + image . edges is continuous.
+void wrap_into_cell(Particles& p, const Box& box) {
   const std::size_t n = p.size();
-  // Wrap into the primary cell; a Lees-Edwards crossing in y shifts x by the offset. The
-  // images crossed are counted, so that the trajectory's position + image . edges is continuous.
   if (p.image.size() != n) p.image.assign(n, {0, 0});
   for (std::size_t k = 0; k < n; ++k) {
     Vec2& x = p.position[k];
@@ -57,17 +59,16 @@ void NeighbourList::rebuild(Particles& p, const Box& box) {
     p.image[k][0] += static_cast<int>(nx);
     p.image[k][1] += static_cast<int>(ny);
   }
+}
 
-  double amax = 0.0;
-  for (double a : p.radius) amax = std::max(amax, a);
-  max_cutoff_ = cutoff(amax, amax);
-  const double rc = max_cutoff_;
-
+// The particles and every periodic image within rc of the cell: y images first (Lees-Edwards),
+// then x images of everything, so corners are covered. Image (kx, ky) of x sits at
+// x + (kx Lx + ky le_offset, ky Ly); kx brings it into [0, Lx).
+ImageCloud image_cloud(const Particles& p, const Box& box, double rc) {
+  const std::size_t n = p.size();
   ImageCloud cloud;
   cloud.pts.reserve(n + n / 4);
   for (std::size_t k = 0; k < n; ++k) cloud.add(p.position[k], static_cast<int>(k), 0, 0);
-  // y images first (Lees-Edwards), then x images of everything, so corners are covered.
-  // Image (kx, ky) of x sits at x + (kx Lx + ky le_offset, ky Ly); kx brings it into [0, Lx).
   if (box.lees_edwards) {
     for (std::size_t k = 0; k < n; ++k) {
       const Vec2& x = p.position[k];
@@ -85,7 +86,19 @@ void NeighbourList::rebuild(Particles& p, const Box& box) {
     if (x.x() < rc) cloud.add(x + Vec2(box.lx, 0.0), who, kx + 1, ky);
     if (x.x() > box.lx - rc) cloud.add(x - Vec2(box.lx, 0.0), who, kx - 1, ky);
   }
+  return cloud;
+}
 
+}  // namespace
+
+void NeighbourList::rebuild(Particles& p, const Box& box) {
+  const std::size_t n = p.size();
+  wrap_into_cell(p, box);
+  double amax = 0.0;
+  for (double a : p.radius) amax = std::max(amax, a);
+  max_cutoff_ = cutoff(amax, amax);
+  const double rc = max_cutoff_;
+  const ImageCloud cloud = image_cloud(p, box, rc);
   Tree tree(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   tree.buildIndex();
 
