@@ -41,7 +41,7 @@ def long_functions(text, limit=LIMIT):
             continue
         indent = re.match(r"^(\s*)", head).group(1)
         for k in range(i + 1, len(lines)):
-            if lines[k] in (indent + "}", indent + "};") or lines[k].startswith(indent + "} catch"):
+            if lines[k] in (indent + "}", indent + "};"):
                 if k - s + 1 > limit:
                     name = re.findall(r"([A-Za-z_~][A-Za-z0-9_:~]*)\s*\(", head)
                     found.append((s + 1, k - s + 1, name[0].split("::")[-1] if name else head))
