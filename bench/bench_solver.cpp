@@ -15,7 +15,7 @@
 #include <Eigen/CholmodSupport>
 #endif
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/solver/detail/cholmod_tuning.hpp"
 #include "sheardiff/solver/sparse_cholesky.hpp"
 

@@ -14,7 +14,7 @@
 #include <memory>
 #include <utility>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace {
 

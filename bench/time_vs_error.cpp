@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace {
 

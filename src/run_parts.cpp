@@ -6,11 +6,14 @@
 #include <cstdio>
 #include <utility>
 
+#include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/version.hpp"
 
@@ -323,6 +326,33 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
     js["phi"] = area / (d.box().lx * d.height());
   }
   return js;
+}
+
+// Only the observers the scene and the config ask for are composed into the run.
+std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
+                                                      const std::filesystem::path& out_dir) {
+  std::vector<std::unique_ptr<Observer>> obs;
+  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
+  MeasuredWindow measuring;
+  // A scene measured from its steady state has the pressure cell's detector of it.
+  if (scene_kind(cfg.scene.type).measured_from_steady_state) {
+    auto cell = std::make_unique<PressureCellObserver>(cfg);
+    const PressureCellObserver* c = cell.get();
+    measuring = [c](const Dynamics&) { return c->steady(); };
+    obs.push_back(std::move(cell));
+  } else {
+    const double from = cfg.run.transient_strain;
+    measuring = [from](const Dynamics& d) { return d.strain() > from; };
+  }
+  if (scene_kind(cfg.scene.type).channel_flow) {
+    obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
+    return obs;
+  }
+  if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
+    obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
+  if (cfg.analysis.diffusion)
+    obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / kAnalysisFile, measuring));
+  return obs;
 }
 
 }  // namespace sheardiff

@@ -1,5 +1,5 @@
 #pragma once
-// The parts a run in a directory is made of (run_to_directory, src/simulation.cpp composes them):
+// The parts a run in a directory is made of (run_to_directory, src/run.cpp composes them):
 // the evolving state of the run and its checkpoint store, the trajectory output, the progress
 // lines and the summary.
 #include <chrono>
@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "sheardiff/engine.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
-#include "sheardiff/simulation.hpp"
 
 namespace sheardiff {
 
@@ -106,5 +106,9 @@ class RunProgress {
 // the health checks' results (observers may also write tables into the trajectory).
 nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
                            RunDirectory& dir, TrajectoryOutput& trajectory);
+
+// The observers the scene and the config ask for (and only those), in their update order.
+std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
+                                                      const std::filesystem::path& out_dir);
 
 }  // namespace sheardiff

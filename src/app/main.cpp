@@ -23,7 +23,7 @@
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 #include "sheardiff/version.hpp"
 

@@ -24,6 +24,7 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/version.hpp"
 
@@ -92,9 +93,13 @@ std::string this_command_line() {
 }
 
 const std::vector<std::string>& run_file_names() {
-  static const std::vector<std::string> names = {
-      "config.toml",    "trajectory.h5",  "analysis.h5", "channel.h5", "summary.json",
-      "checkpoint.bin", "diagnostic.txt", kLog,          "reanalysis"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n = {kConfigFile, kTrajectoryFile};
+    n.insert(n.end(), kAnalyserFiles.begin(), kAnalyserFiles.end());
+    for (const char* f : {kSummaryFile, kCheckpointFile, kDiagnosticFile, kLog, kReanalysisFolder})
+      n.emplace_back(f);
+    return n;
+  }();
   return names;
 }
 
@@ -196,7 +201,7 @@ class RunDirectory::OutputTee {
         }
         if (saved_[k] >= 0) write_all(saved_[k], buf, static_cast<std::size_t>(n));
         // A line redrawn after '\r' (a terminal's live progress, twice a second) is not
-        // logged: the log gets timestamped progress lines instead (simulation.cpp).
+        // logged: the log gets timestamped progress lines instead (run.cpp).
         for (ssize_t i = 0; i < n; ++i) {
           if (buf[i] == '\r') {
             line_[k].clear();

@@ -10,7 +10,9 @@
 #include "sheardiff/core/output_schedule.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/analysis_file.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/version.hpp"
@@ -102,8 +104,7 @@ void DiffusionObserver::serialize(Archive& a) {
 
 void DiffusionObserver::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*) {
   try {
-    if (particles_ == 0)
-      throw std::invalid_argument("no sample was taken in the measured window");
+    if (particles_ == 0) throw std::invalid_argument("no sample was taken in the measured window");
     DiffusionReport r = acc_.report();
     if (skipped_ > 0)
       r.warnings.push_back(fmt::format(
@@ -251,8 +252,8 @@ Reanalysis write_reanalysis(const std::filesystem::path& dir, const nlohmann::js
   if (summary_changes) out.summary["analysed_by"] = version_line();
   const bool beside = out.folder != dir;
   if (beside) std::filesystem::create_directories(out.folder);
-  if (report && (beside || !std::filesystem::exists(dir / "analysis.h5")))
-    write_analysis_file(*report, out.folder / "analysis.h5");
+  if (report && (beside || !std::filesystem::exists(dir / kAnalysisFile)))
+    write_analysis_file(*report, out.folder / kAnalysisFile);
   if (summary_changes || beside)
     write_file_atomically(out.folder / "summary.json", json_text(out.summary) + "\n");
   return out;

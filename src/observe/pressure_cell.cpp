@@ -8,7 +8,7 @@
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/analysis/uncertainty.hpp"
 #include "sheardiff/io/h5md.hpp"
-#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/integrator/stress.hpp"
 
 namespace sheardiff {
 

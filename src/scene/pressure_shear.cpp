@@ -46,7 +46,7 @@ std::vector<WallDisc> rough_wall(double lx, double base, int side, const Config&
 }  // namespace
 
 Scene build_pressure_shear(const Config& cfg) {
-  Packing pk = initial_packing(cfg);
+  Packing pk = initial_packing(cfg, false);
   std::mt19937_64 rng(static_cast<std::uint64_t>(cfg.run.seed) ^ 0x9e3779b97f4a7c15ULL);
   const double lx = pk.lx;
   double amax = 0.0;

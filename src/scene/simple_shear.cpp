@@ -6,7 +6,7 @@
 namespace sheardiff {
 
 Scene build_simple_shear(const Config& cfg) {
-  Packing pk = initial_packing(cfg);
+  Packing pk = initial_packing(cfg, true);
   Scene sc;
   sc.particles.resize(pk.position.size());
   sc.particles.n_mobile = pk.position.size();

@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "sheardiff/io/h5md.hpp"
-#include "sheardiff/scene/registry.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
 namespace sheardiff {
@@ -39,7 +38,7 @@ void refuse_overlaps(const Packing& pk, bool periodic_y, const std::filesystem::
     }
 }
 
-Packing packing_from_file(const Config& cfg) {
+Packing packing_from_file(const Config& cfg, bool periodic_y) {
   const std::filesystem::path file = cfg.particles.init_file;
   Packing pk;
   std::vector<double> diameter;
@@ -79,18 +78,18 @@ Packing packing_from_file(const Config& cfg) {
         fmt::format("particles.init_file: {} holds {} mobile particles but "
                     "particles.N = {}",
                     file.string(), pk.position.size(), cfg.particles.n));
-  refuse_overlaps(pk, scene_kind(cfg.scene.type).periodic_y, file);
+  refuse_overlaps(pk, periodic_y, file);
   return pk;
 }
 
 }  // namespace
 
-Packing initial_packing(const Config& cfg) {
+Packing initial_packing(const Config& cfg, bool periodic_y) {
   return cfg.particles.init_file.empty()
              ? random_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
                               cfg.particles.phi_init, cfg.particles.aspect,
                               static_cast<std::uint64_t>(cfg.run.seed))
-             : packing_from_file(cfg);
+             : packing_from_file(cfg, periodic_y);
 }
 
 }  // namespace sheardiff

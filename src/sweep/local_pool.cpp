@@ -22,7 +22,7 @@
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/io/text.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 extern char** environ;

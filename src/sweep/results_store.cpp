@@ -8,6 +8,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {
@@ -53,7 +54,10 @@ bool export_point(const SweepSpec& spec, const SweepPoint& p, const fs::path& ou
   fs::create_directories(dst);
   bool copied = false;
   // config.toml first and summary.json last: a stored point counts once its summary is there.
-  for (const char* name : {"config.toml", "analysis.h5", "channel.h5", "summary.json"}) {
+  std::vector<const char*> names = {kConfigFile};
+  names.insert(names.end(), kAnalyserFiles.begin(), kAnalyserFiles.end());
+  names.push_back(kSummaryFile);
+  for (const char* name : names) {
     if (!fs::exists(src / name)) continue;
     const std::string bytes = read_all(src / name);
     if (fs::exists(dst / name) && read_all(dst / name) == bytes) continue;

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "sheardiff/config.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {

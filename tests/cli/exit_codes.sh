@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Exit codes exactly as README's table (issue 16, finding 9): usage errors of the command line
+# Exit codes exactly as README's list ("Exit codes"): usage errors of the command line
 # exited 105-114 (CLI11's own codes), I/O errors 3 (documented 1), a damaged summary.json 1
 # without its name. Each case: the exit code and a fragment of stderr (or stdout for --help).
 #

@@ -11,7 +11,7 @@
 #include "sheardiff/interactions/stokes_drag.hpp"
 #include "sheardiff/io/hdf5_tables.hpp"
 #include "sheardiff/observe/channel.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
 
 namespace sheardiff {

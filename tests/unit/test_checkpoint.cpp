@@ -21,7 +21,7 @@
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/io/text.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {

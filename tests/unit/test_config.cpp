@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "sheardiff/config.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "sheardiff/observe/diffusion_observer.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

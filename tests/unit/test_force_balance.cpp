@@ -11,7 +11,7 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/dynamics.hpp"
 #include "sheardiff/scene/scene.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/solver/force_balance.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
 

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/setup/random_packing.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

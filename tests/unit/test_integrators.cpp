@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

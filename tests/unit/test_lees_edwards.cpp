@@ -13,7 +13,7 @@
 #include "sheardiff/neighbour/neighbour_list.hpp"
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

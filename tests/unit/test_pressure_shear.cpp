@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

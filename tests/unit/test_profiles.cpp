@@ -6,7 +6,8 @@
 #include <numeric>
 
 #include "sheardiff/observe/profiles.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
+#include "sheardiff/run_parts.hpp"
 
 namespace sheardiff {
 namespace {

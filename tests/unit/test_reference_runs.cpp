@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

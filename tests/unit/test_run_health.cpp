@@ -11,7 +11,7 @@
 
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/observe/run_health.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

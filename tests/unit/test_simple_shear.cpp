@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

@@ -8,7 +8,8 @@
 #include <filesystem>
 
 #include "sheardiff/observe/observer.hpp"
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
+#include "sheardiff/run_parts.hpp"
 
 namespace sheardiff {
 namespace {

@@ -12,7 +12,7 @@
 #include <cmath>
 #include <vector>
 
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

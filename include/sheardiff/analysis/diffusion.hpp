@@ -126,7 +126,5 @@ Eigen::MatrixXd bulk_mask(const Eigen::MatrixXd& y, const Eigen::VectorXd& botto
 // Adds D, D_err, D_regression_stderr, dv, dv_err, psi, psi_err, psi_e, psi_zero, psi_full
 // (each with _err), step_length, msd_window, msd_window_slope, the *_bulk values, ... to summary.
 void add_to_summary(const DiffusionReport& r, nlohmann::json& summary);
-// DIR/analysis.h5: /msd/{lag, msd, samples}, /vacf/{lag, c}, fit results as attributes of /.
-void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& file);
 
 }  // namespace sheardiff

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "sheardiff/integrator/dynamics.hpp"
-#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/integrator/stress.hpp"
 
 namespace sheardiff {
 

@@ -12,7 +12,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/dynamics.hpp"
-#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/integrator/stress.hpp"
 
 namespace sheardiff {
 

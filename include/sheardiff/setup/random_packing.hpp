@@ -27,8 +27,9 @@ struct Packing {
 Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,
                        std::uint64_t seed);
 
-// The mobile particles of cfg: a random packing, or the configuration of particles.init_file.
-Packing initial_packing(const struct Config& cfg);
+// The mobile particles of cfg: a random packing, or the configuration of particles.init_file
+// (whose overlaps are judged across y too where the scene is periodic in y).
+Packing initial_packing(const struct Config& cfg, bool periodic_y);
 
 // Relax overlaps of discs in a cell periodic in x (and in y if periodic_y) by overdamped
 // steepest descent on a harmonic repulsion; returns the largest remaining overlap.

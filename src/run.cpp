@@ -1,4 +1,4 @@
-#include "sheardiff/simulation.hpp"
+#include "sheardiff/run.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -14,151 +14,21 @@
 #include <iterator>
 #include <limits>
 
+#include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
-#include "sheardiff/observe/channel.hpp"
-#include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/observer.hpp"
-#include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/observe/run_health.hpp"
-#include "sheardiff/observe/stress.hpp"
 #include "sheardiff/run_parts.hpp"
-#include "sheardiff/setup/random_packing.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {
-
-double interaction_range_factor(const Config& cfg) {
-  return PairLaws::from(cfg).range_factor();
-}
-
-double explicit_stability_dt(const Config& cfg) {
-  return PairLaws::from(cfg).explicit_stability_dt();
-}
-
-bool rotational_unknowns(const Config& cfg) {
-  // Without a law that couples rotation to translation, omega = omega_inf + T_ext / drag.
-  return cfg.solver.rotations == "always" || PairLaws::from(cfg).needs_rotations();
-}
-
-void validate_run_inputs(const Config& cfg, const std::string& origin) {
-  if (cfg.integrator.type != IntegratorType::Implicit && cfg.integrator.dt > 0.0) {
-    const double limit = explicit_stability_dt(cfg);
-    if (cfg.integrator.dt >= limit)
-      throw ConfigError(fmt::format(
-          "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
-          "eta/P of explicit springs (smallest pair, normal and slip modes, "
-          "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use "
-          "integrator.dt < "
-          "{:.3g}, integrator.dt = 0 (adaptive), or "
-          "integrator.type = \"implicit\"",
-          origin, cfg.integrator.dt, limit, to_string(cfg.integrator.type), cfg.contact.ktilde,
-          limit));
-  }
-  double lx = 0.0, ly = 0.0, amax = 0.5 * std::max(1.0, cfg.particles.size_ratio);
-  if (!cfg.particles.init_file.empty()) {
-    try {
-      const Packing pk = initial_packing(cfg);
-      lx = pk.lx, ly = pk.ly;
-      for (double a : pk.radius) amax = std::max(amax, a);
-    } catch (const ConfigError& e) {
-      throw ConfigError(fmt::format("{}: {}", origin, e.what()));
-    } catch (const std::exception& e) {
-      throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
-    }
-  } else if (scene_kind(cfg.scene.type).channel_flow) {
-    lx = static_cast<double>(cfg.channel.wall_discs);
-    ly = cfg.channel.h_over_a * 0.5;
-  } else {
-    // The cell random_packing makes, without placing anything.
-    double area = 0.0;
-    for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio)) {
-      const double a = s == 0 ? 0.5 : 0.5 * cfg.particles.size_ratio;
-      area += kPi * a * a;
-    }
-    lx = std::sqrt(area / cfg.particles.phi_init / cfg.particles.aspect);
-    ly = cfg.particles.aspect * lx;
-  }
-  // The neighbour list holds one image of each pair: a periodic edge within two list cut-offs
-  // of the largest pair lets a disc meet its own image (ignored, so its stress is lost) or a
-  // pair meet twice (one contact history for two images).
-  const double cutoff = 2.0 * amax * interaction_range_factor(cfg) + cfg.neighbour.skin;
-  const bool periodic_y = scene_kind(cfg.scene.type).periodic_y;
-  const double edge = periodic_y ? std::min(lx, ly) : lx;
-  if (!(edge > 2.0 * cutoff))
-    throw ConfigError(fmt::format(
-        "{}: particles.N: the periodic cell is {:.3g} x {:.3g} d ({} = {:.3g} d), but a periodic "
-        "edge must exceed twice the neighbour cut-off of the largest pair, 2 x {:.3g} = {:.3g} d "
-        "(diameter {:g} d, lubrication range and neighbour.skin = {:g} d), or a disc meets its "
-        "own image; raise particles.N{}, lower neighbour.skin or lubrication.h_max",
-        origin, lx, ly, periodic_y && ly < lx ? "Ly" : "Lx", edge, cutoff, 2.0 * cutoff, 2.0 * amax,
-        cfg.neighbour.skin,
-        cfg.particles.init_file.empty() ? ", bring particles.aspect closer to 1" : ""));
-}
-
-Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
-
-Simulation::Simulation(const Config& cfg, Scene scene)
-    : cfg_(cfg), integrator_(make_integrator(cfg.integrator.type)) {
-  StepLimits lim;
-  lim.fixed_dt = cfg.integrator.dt;
-  lim.max_displacement = cfg.integrator.max_displacement;
-  lim.max_gap_fraction = cfg.integrator.max_gap_fraction;
-  lim.max_overlap_change = overlap_change_limit(cfg);
-  lim.max_entry_overlap = cfg.integrator.max_entry_overlap;
-  lim.max_strain_step = cfg.integrator.max_strain_step;
-  lim.end_time = cfg.run.strain / scene.flow.clock_rate();
-  if (!integrator_->implicit_springs())
-    lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
-  const double range = interaction_range_factor(cfg);
-  ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
-                  integrator_->implicit_springs(), cfg.solver.cholesky);
-  if (scene.fluid) fb.set_fluid(std::move(*scene.fluid));
-  dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
-                                         std::move(fb), NeighbourList(range, cfg.neighbour.skin),
-                                         lim, std::move(scene.walls));
-}
-
-void Simulation::step() {
-  if (!integrator_->step(*dynamics_))
-    throw std::runtime_error(fmt::format(
-        "linear solve failed at step {} (strain {:.6g}): the resistance matrix is not positive "
-        "definite or the velocities are not finite",
-        dynamics_->steps(), dynamics_->strain()));
-}
-
-// Only the observers the scene and the config ask for are composed into the run.
-std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
-                                                      const std::filesystem::path& out_dir) {
-  std::vector<std::unique_ptr<Observer>> obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  MeasuredWindow measuring;
-  // A scene measured from its steady state has the pressure cell's detector of it.
-  if (scene_kind(cfg.scene.type).measured_from_steady_state) {
-    auto cell = std::make_unique<PressureCellObserver>(cfg);
-    const PressureCellObserver* c = cell.get();
-    measuring = [c](const Dynamics&) { return c->steady(); };
-    obs.push_back(std::move(cell));
-  } else {
-    const double from = cfg.run.transient_strain;
-    measuring = [from](const Dynamics& d) { return d.strain() > from; };
-  }
-  if (scene_kind(cfg.scene.type).channel_flow) {
-    obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / "channel.h5"));
-    return obs;
-  }
-  if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
-    obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
-  if (cfg.analysis.diffusion)
-    obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / "analysis.h5", measuring));
-  return obs;
-}
 
 namespace {
 
@@ -233,10 +103,10 @@ std::string restart_would_lose(const RunDirectory& dir, const Config& cfg) {
   if (fs::exists(dir.file("summary.json"), ec) || fs::exists(dir.file("checkpoint.bin"), ec))
     return {};
   std::vector<std::string> kept;
-  for (const char* name : {"analysis.h5", "channel.h5"})
+  for (const char* name : kAnalyserFiles)
     if (fs::exists(dir.file(name), ec))
       kept.push_back(fmt::format("{} (written when a run finishes)", name));
-  if (fs::exists(dir.file("reanalysis"), ec))
+  if (fs::exists(dir.file(kReanalysisFolder), ec))
     kept.push_back("reanalysis/ (written by analyse on a finished run)");
   const auto traj = dir.file("trajectory.h5");
   if (cfg.output.checkpoint_strain > 0 && fs::exists(traj, ec)) {
@@ -347,7 +217,7 @@ nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seco
   // channel.h5's writer does not check its file's close (analysis.h5's does since it throws on
   // a failed flush or close): a full disk there would leave a truncated file under the final
   // name, which HDF5 then refuses to open.
-  for (const char* name : {"analysis.h5", "channel.h5"}) {
+  for (const char* name : kAnalyserFiles) {
     const auto file = dir.file(name);
     if (std::filesystem::exists(file) && !hdf5_file_opens(file)) {
       std::filesystem::remove(file);

@@ -1,4 +1,4 @@
-#include "sheardiff/observe/stress.hpp"
+#include "sheardiff/integrator/stress.hpp"
 
 #include <algorithm>
 

@@ -1,0 +1,55 @@
+#pragma once
+// The engine as a value: constructed from a configuration (or a hand-made scene), stepped, its
+// state read. Nothing here writes a file: a run to a directory is run.hpp.
+#include <memory>
+#include <string>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/integrator/integrators.hpp"
+#include "sheardiff/integrator/stress.hpp"
+#include "sheardiff/scene/scene.hpp"
+
+namespace sheardiff {
+
+// A run as a value: the scene, the engine composed for it and the integrator. Tests build one
+// from a Config (or a hand-made Scene) and step it.
+class Simulation {
+ public:
+  explicit Simulation(const Config& cfg);
+  Simulation(const Config& cfg, Scene scene);
+
+  // One integrator step; throws std::runtime_error if the linear solve fails.
+  void step();
+  // One integrator step; false if the linear solve failed (the state is then unchanged).
+  bool try_step() { return integrator_->step(*dynamics_); }
+  StressSample sample() const { return integrator_->sample(*dynamics_, cfg_.flow.lz); }
+
+  const Config& config() const { return cfg_; }
+  Dynamics& dynamics() { return *dynamics_; }
+  const Dynamics& dynamics() const { return *dynamics_; }
+  const Integrator& integrator() const { return *integrator_; }
+  void serialize_integrator(Archive& a) { integrator_->serialize(a); }
+
+ private:
+  Config cfg_;
+  std::unique_ptr<Integrator> integrator_;
+  std::unique_ptr<Dynamics> dynamics_;
+};
+
+// Pair interaction range over the sum of the radii: lubrication reaches gaps up to h_max.
+double interaction_range_factor(const Config& cfg);
+
+// Contact stability limit of explicit springs for these parameters (docs/model.md section 7).
+double explicit_stability_dt(const Config& cfg);
+
+// Whether the run needs the rotational unknowns (3 per particle) or only translation (2).
+bool rotational_unknowns(const Config& cfg);
+
+// The checks of a configuration that need the physics or input files (parse_config does the
+// rest): a fixed dt of explicit springs below their stability limit, particles.init_file
+// readable with particles.N mobile particles, and a periodic cell wider than two neighbour
+// cut-offs of the largest pair. Throws ConfigError naming origin and the key.
+// Writes nothing: `sheardiff check` and `run` call it before any output exists.
+void validate_run_inputs(const Config& cfg, const std::string& origin);
+
+}  // namespace sheardiff
