@@ -15,14 +15,16 @@ namespace sheardiff {
 
 // Limits on one step (docs/model.md section 7). fixed_dt > 0 switches the adaptive choice off.
 struct StepLimits {
+  // Every limit is set from the configuration (engine.cpp), whose schema holds the defaults and
+  // the allowed ranges; none is a default of its own here.
   double fixed_dt = 0.0;
-  double max_displacement = 1e-3;  // non-affine, d
-  double max_gap_fraction = 0.5;   // of (gap + delta s / 2)
-  double max_overlap_change = 1e-3;
+  double max_displacement = 0.0;  // non-affine, d
+  double max_gap_fraction = 0.0;  // of (gap + delta s / 2)
+  double max_overlap_change = 0.0;
   // Largest overlap a closing pair may reach in the step it touches (0 = none): the gap limit
-  // alone lets it reach max_gap_fraction x delta s / 2 (0.0025 d at the defaults).
+  // alone lets it reach max_gap_fraction x delta s / 2.
   double max_entry_overlap = 0.0;
-  double max_strain_step = 1e-2;
+  double max_strain_step = 0.0;
   double explicit_dt = 0.0;  // stability cap of explicit springs (0 = none)
   double end_time = 0.0;     // a fixed dt is shortened to land on it (0 = none)
 };
