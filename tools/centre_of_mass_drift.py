@@ -10,7 +10,8 @@ net_drag_y observable. A stationary cell has all three at zero (docs/results.md,
 import argparse
 import pathlib
 
-import h5py
+import rundir  # tools/rundir.py: what every tool reads of a run
+
 import numpy as np
 
 
@@ -19,7 +20,7 @@ def main():
     ap.add_argument("run", type=pathlib.Path)
     ap.add_argument("--every", type=int, default=5, help="use every K-th frame (default 5)")
     a = ap.parse_args()
-    with h5py.File(a.run / "trajectory.h5", "r", locking=False) as f:
+    with rundir.Run(a.run).open("trajectory") as f:
         g = f["particles/suspension"]
         mobile = g["motion"][()] == 0
         d = g["diameter"][()][mobile]

@@ -48,6 +48,7 @@ import warnings
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rundir  # noqa: E402  (tools/rundir.py: what every tool reads of a run)
 import suspension_balance as sb  # noqa: E402
 
 # Table columns: (label, our summary key (None: the width-average u_p of load_run), Table 1 /
@@ -98,12 +99,11 @@ HISTORY_SERIES = ("time", "pressure_gradient_ratio", "centre_distance", "u_p_mea
 def load_history(path):
     """RUN_DIR/channel.h5's /channel_history as the dict of lists that summary.json once held
     (profile rows as lists, nan for an empty bin); {} if the run has no such file."""
-    f = os.path.join(path, "channel.h5")
-    if not os.path.isfile(f):
+    f = rundir.Run(path).file("channel")
+    if not f.is_file():
         return {}
-    import h5py
     try:
-        with h5py.File(f, "r") as h5:
+        with rundir.open_h5(f) as h5:
             g = h5["channel_history"]
             return {k: np.asarray(g[k], float).tolist() for k in HISTORY_SERIES + PROFILES}
     except (OSError, KeyError) as e:

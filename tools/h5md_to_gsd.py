@@ -16,6 +16,8 @@ import argparse
 import pathlib
 import sys
 
+import rundir  # tools/rundir.py: what every tool reads of a run
+
 import numpy as np
 
 TYPES = ["small", "large", "fixed_wall", "floating_wall", "driven_wall"]
@@ -41,7 +43,7 @@ def new_frame():
 def export(h5_path, out):
     import h5py
 
-    with h5py.File(h5_path, "r") as f:
+    with rundir.open_h5(h5_path) as f:
         groups = list(f["particles"])
         name = "suspension" if "suspension" in groups else groups[0]
         g = f["particles"][name]

@@ -8,15 +8,17 @@ window, a drift check): bulk phi, mu = (mu_top + mu_bottom)/2, the particle-aver
 omega/gammadot and v_y/gammadot, and the mean omega/gammadot (the fluid's is -1/2). Works on a
 run stopped by a signal (no summary.json) as long as its trajectory is closed.
 """
-import json, os, sys
+import os, sys
 
-import h5py
+import rundir  # tools/rundir.py: what every tool reads of a run
+
 import numpy as np
 
 for arg in sys.argv[1:]:
     d, lo = (arg.rsplit(':', 1) + ['2'])[:2] if ':' in arg else (arg, '2')
     lo = float(lo)
-    with h5py.File(os.path.join(d, 'trajectory.h5'), 'r') as f:
+    run = rundir.Run(d)
+    with run.open('trajectory') as f:
         o = f['observables']
         s = o['strain/value'][:]
         t = o['strain/time'][:]
@@ -30,8 +32,7 @@ for arg in sys.argv[1:]:
         vy = p['velocity/value'][:][:, mobile, 1] / J
     idx = np.where(sel)[0]
     a, b = idx[: len(idx) // 2], idx[len(idx) // 2:]
-    summ = os.path.join(d, 'summary.json')
-    sps = json.load(open(summ)).get('steps_per_strain', float('nan')) if os.path.exists(summ) else float('nan')
+    sps = run.summary.get('steps_per_strain', float('nan'))
     print(f'{os.path.basename(d.rstrip("/")):16s} J {J:.0e} strain {s[-1]:5.1f} window [{lo:g},] '
           f'phi {phi[sel].mean():.4f} ({phi[a].mean():.4f} {phi[b].mean():.4f})  '
           f'mu {mu[sel].mean():.3f} ({mu[a].mean():.3f} {mu[b].mean():.3f})  '

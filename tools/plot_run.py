@@ -17,10 +17,10 @@ analysis.png (only with analysis.h5): the MSD in the gradient direction with the
 the line 2 D t + c, and the velocity autocorrelation C(tau)/C(0) with the persistence time Psi.
 """
 import argparse
-import json
 import pathlib
 import sys
-import tomllib
+
+import rundir  # tools/rundir.py: what every tool reads of a run
 
 import matplotlib
 
@@ -31,9 +31,7 @@ from scipy import ndimage, stats  # noqa: E402
 
 
 def load_series(traj):
-    import h5py
-
-    with h5py.File(traj, "r") as f:
+    with rundir.open_h5(traj) as f:
         obs = f["observables"]
         return {k: obs[k]["value"][()] for k in obs if "value" in obs[k]}
 
@@ -94,9 +92,9 @@ def window_numbers(strain, rows, window, summary, block, pressure_cell):
 
 
 def plot_timeseries(run, out, print_numbers=False):
-    traj = run / "trajectory.h5"
-    cfg = tomllib.loads((run / "config.toml").read_text()) if (run / "config.toml").is_file() else {}
-    summary = json.loads((run / "summary.json").read_text()) if (run / "summary.json").is_file() else {}
+    r = rundir.Run(run)
+    traj = r.file("trajectory")
+    cfg, summary = r.config, r.summary
     series = load_series(traj)
     if "strain" not in series or len(series["strain"]) == 0:
         sys.exit(f"plot_run: {traj} holds no frames yet")
@@ -148,10 +146,8 @@ def plot_timeseries(run, out, print_numbers=False):
 
 
 def plot_analysis(run, out):
-    import h5py
-
-    summary = json.loads((run / "summary.json").read_text())
-    with h5py.File(run / "analysis.h5", "r") as f:
+    summary = rundir.Run(run).summary
+    with rundir.Run(run).open("analysis") as f:
         lag, msd = f["msd/lag"][()], f["msd/msd"][()]
         tau, c = f["vacf/lag"][()], f["vacf/c"][()]
         d, intercept = f.attrs["D"], f.attrs["msd_intercept"]
@@ -196,11 +192,12 @@ def main():
     ap.add_argument("--out", type=pathlib.Path, help="time-series PNG (default RUN/timeseries.png)")
     ap.add_argument("--print", action="store_true", help="also print each panel's mean +- error and its source")
     args = ap.parse_args()
-    if not (args.run / "trajectory.h5").is_file():
-        sys.exit(f"plot_run: no trajectory at {args.run / 'trajectory.h5'} (run with output.trajectory = true)")
+    run = rundir.Run(args.run)
+    if not run.has("trajectory"):
+        sys.exit(f"plot_run: no trajectory at {run.file('trajectory')} (run with output.trajectory = true)")
     try:
         plot_timeseries(args.run, args.out or args.run / "timeseries.png", args.print)
-        if (args.run / "analysis.h5").is_file() and (args.run / "summary.json").is_file():
+        if run.has("analysis") and run.finished:
             plot_analysis(args.run, args.run / "analysis.png")
     except (OSError, KeyError) as e:
         sys.exit(f"plot_run: {args.run}: cannot read the run ({type(e).__name__}: {e})")

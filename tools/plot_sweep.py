@@ -26,6 +26,8 @@ import math
 import pathlib
 import sys
 
+import rundir  # tools/rundir.py: what every tool reads of a run
+
 SEED = {  # seed Table 1 (suspensions) and eq. (3.3)
     "D": (0.024, -0.26), "dv": (0.258, -0.25), "psi": (0.35, 0.24),
     "D_phi": (0.019, -0.61), "dv_phi": (0.25, -0.54), "psi_phi": (0.37, 0.51),
@@ -85,7 +87,7 @@ def main():
             f = base / "points" / r["point"].split("/")[-1] / "analysis.h5"
             if not f.exists():
                 continue
-            with h5py.File(f, "r") as h:
+            with rundir.open_h5(f) as h:
                 lag, msd = h["msd/lag"][()], h["msd/msd"][()]
                 window = (h.attrs.get("msd_window_lo"), h.attrs.get("msd_window_hi"))
             ok = lag > 0

@@ -9,10 +9,10 @@ y edges shifted by the frame's tilt (box/edges). The title gives the run's J, ph
     /usr/bin/python3 tools/snapshot.py RUN_DIR [--frame -1] [--out RUN_DIR/snapshot.png]
 """
 import argparse
-import json
 import pathlib
 import sys
-import tomllib
+
+import rundir  # tools/rundir.py: what every tool reads of a run
 
 import matplotlib
 
@@ -24,9 +24,7 @@ import numpy as np  # noqa: E402
 
 
 def read_frame(path, frame):
-    import h5py
-
-    with h5py.File(path, "r") as f:
+    with rundir.open_h5(path) as f:
         groups = list(f["particles"])
         g = f["particles"]["suspension" if "suspension" in groups else groups[0]]
         pos = g["position/value"]
@@ -49,9 +47,8 @@ def read_frame(path, frame):
 
 
 def title_of(run_dir, fr):
-    cfg_file, summ_file = run_dir / "config.toml", run_dir / "summary.json"
-    cfg = tomllib.loads(cfg_file.read_text()) if cfg_file.is_file() else {}
-    summary = json.loads(summ_file.read_text()) if summ_file.is_file() else {}
+    run = rundir.Run(run_dir)
+    cfg, summary = run.config, run.summary
     j = cfg.get("flow", {}).get("J", summary.get("J"))
     mobile = fr["motion"] == 0
     if "phi" in summary:  # the run's: fixed, or the steady mean of a pressure cell

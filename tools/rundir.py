@@ -1,0 +1,69 @@
+"""What every tool reads of a run directory, in one place.
+
+The file names come from the C++ declaration (include/sheardiff/io/run_files.hpp), so the run,
+the run directory's rules and these tools cannot disagree on them. HDF5 files are opened
+without the HDF5 file lock, so a trajectory can be read while its run writes it (the writer
+flushes it every few seconds; a frame being written may be missing, never half-read from an
+earlier one).
+
+    import rundir
+    run = rundir.Run("runs/quick")
+    run.summary        # summary.json as a dict ({} for an unfinished run)
+    run.config         # config.toml as a dict ({} if absent)
+    with run.open("trajectory") as f: ...   # or "analysis", "channel"
+"""
+import json
+import pathlib
+import re
+import tomllib
+
+_HEADER = pathlib.Path(__file__).resolve().parent.parent / "include/sheardiff/io/run_files.hpp"
+# kAnalysisFile -> "analysis.h5", ..., read from the header's `inline constexpr const char* kX = "...";`
+NAMES = dict(re.findall(r'constexpr const char\* (k\w+) = "([^"]+)"', _HEADER.read_text()))
+FILES = {
+    "config": NAMES["kConfigFile"],
+    "trajectory": NAMES["kTrajectoryFile"],
+    "analysis": NAMES["kAnalysisFile"],
+    "channel": NAMES["kChannelFile"],
+    "summary": NAMES["kSummaryFile"],
+    "checkpoint": NAMES["kCheckpointFile"],
+}
+
+
+def open_h5(path):
+    """An HDF5 file for reading, also while its writer still has it open."""
+    import h5py
+
+    return h5py.File(path, "r", locking=False)
+
+
+def read_json(path):
+    return json.loads(pathlib.Path(path).read_text())
+
+
+class Run:
+    """A run directory (finished or not)."""
+
+    def __init__(self, path):
+        self.path = pathlib.Path(path)
+
+    def file(self, kind):
+        return self.path / FILES[kind]
+
+    def has(self, kind):
+        return self.file(kind).is_file()
+
+    def open(self, kind):
+        return open_h5(self.file(kind))
+
+    @property
+    def finished(self):
+        return self.has("summary")
+
+    @property
+    def summary(self):
+        return read_json(self.file("summary")) if self.has("summary") else {}
+
+    @property
+    def config(self):
+        return tomllib.loads(self.file("config").read_text()) if self.has("config") else {}
