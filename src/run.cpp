@@ -1,6 +1,7 @@
 #include "sheardiff/run.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <map>
+#include <sstream>
 
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
@@ -55,15 +58,50 @@ struct StopSignals {
   }
 };
 
-// Whether DIR/config.toml holds this resolved configuration (compared through the parser, so
-// that keys added to the code since do not make it look foreign).
-bool same_config(const std::filesystem::path& file, const std::string& resolved) {
-  try {
-    return to_toml(load_config(file)) == resolved;
-  } catch (const ConfigError&) {
-    return false;
+// The resolved configuration as "section.key" -> value text, from to_toml's lines.
+std::map<std::string, std::string> config_entries(const std::string& toml_text) {
+  std::map<std::string, std::string> out;
+  std::istringstream in(toml_text);
+  std::string line, section;
+  while (std::getline(in, line)) {
+    if (line.empty() || line.front() == '#') continue;
+    if (line.front() == '[') {
+      section = line.substr(1, line.find(']') - 1);
+      continue;
+    }
+    const auto eq = line.find(" = ");
+    if (eq != std::string::npos) out[section + "." + line.substr(0, eq)] = line.substr(eq + 3);
   }
+  return out;
 }
+
+// How DIR/config.toml differs from this resolved configuration, one "key: was -> now" each
+// (compared through the parser, so that keys added to the code since do not make it look
+// foreign); empty when it is the same.
+std::vector<std::string> config_changes(const std::filesystem::path& file,
+                                        const std::string& resolved) {
+  std::string was;
+  try {
+    was = to_toml(load_config(file));
+  } catch (const ConfigError& e) {
+    return {fmt::format("{} no longer reads as a configuration ({})", file.string(), e.what())};
+  }
+  if (was == resolved) return {};
+  const auto a = config_entries(was), b = config_entries(resolved);
+  std::vector<std::string> changes;
+  for (const auto& [key, value] : b) {
+    const auto it = a.find(key);
+    if (it == a.end())
+      changes.push_back(fmt::format("{}: not set -> {}", key, value));
+    else if (it->second != value)
+      changes.push_back(fmt::format("{}: {} -> {}", key, it->second, value));
+  }
+  for (const auto& [key, value] : a)
+    if (!b.count(key)) changes.push_back(fmt::format("{}: {} -> not set", key, value));
+  if (changes.empty()) changes.push_back("the files differ in form only");
+  return changes;
+}
+
 std::string refusal(const RunDirectory& dir) {
   const std::string d = dir.path().string();
   switch (dir.state()) {
@@ -153,12 +191,12 @@ bool check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
     if (state == RunState::started)
       if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
         throw ConfigError("--resume " + lost);
-    if (std::filesystem::exists(dir.file("config.toml")) &&
-        !same_config(dir.file("config.toml"), resolved))
-      throw ConfigError(fmt::format(
-          "--resume {}: the configuration differs from the one the run was started with (see "
-          "{}/config.toml)",
-          out, out));
+    if (std::filesystem::exists(dir.file("config.toml")))
+      if (const auto changes = config_changes(dir.file("config.toml"), resolved); !changes.empty())
+        throw ConfigError(fmt::format(
+            "--resume {}: the configuration differs from the one the run was started with ({}; "
+            "see {}/config.toml)",
+            out, fmt::join(changes, "; "), out));
   }
   return mode == RunMode::resume && state == RunState::interrupted;
 }

@@ -74,8 +74,10 @@ mkdir early && : > early/trajectory.h5
 expect 2 "stopped before its first checkpoint (config.toml, trajectory.h5)" -- run run.toml --out early
 expect 0 "no checkpoint was written before the run stopped: starting again from strain 0" -- run run.toml --resume early --set output.trajectory=false
 [ -e early/trajectory.h5 ] && fail "the partial trajectory.h5 survived the restart"
-# Resuming with another configuration is refused (exit 2), whatever the state.
-expect 2 "the configuration differs from the one the run was started with" -- run run.toml --resume int --set flow.J=0.05
+# Resuming with another configuration is refused (exit 2), whatever the state, naming each key
+# that changed with its old and new value.
+expect 2 "the configuration differs from the one the run was started with (" -- run run.toml --resume int --set flow.J=0.05
+grep -qF "flow.J: 0.01 -> 0.05" cmd.err || fail "the refusal does not name flow.J: $(cat cmd.err)"
 # Nothing to resume.
 mkdir empty
 expect 2 "--resume empty: there is no run there to resume" -- run run.toml --resume empty
