@@ -126,7 +126,7 @@ void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
 void TrajectoryOutput::flush_now_and_then() {
   if (!writer_) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_flush_ > std::chrono::seconds(30)) {
+  if (now - last_flush_ > std::chrono::seconds(2)) {
     writer_->flush();
     last_flush_ = now;
   }

@@ -1,10 +1,9 @@
 """What every tool reads of a run directory, in one place.
 
 The file names come from the C++ declaration (include/sheardiff/io/run_files.hpp), so the run,
-the run directory's rules and these tools cannot disagree on them. HDF5 files are opened
-without the HDF5 file lock, so a trajectory can be read while its run writes it (the writer
-flushes it every few seconds; a frame being written may be missing, never half-read from an
-earlier one).
+the run directory's rules and these tools cannot disagree on them. HDF5 files are opened in
+single-writer/multiple-reader mode, so a trajectory can be read while its run writes it (the
+run flushes it every two seconds).
 
     import rundir
     run = rundir.Run("runs/quick")
@@ -31,10 +30,15 @@ FILES = {
 
 
 def open_h5(path):
-    """An HDF5 file for reading, also while its writer still has it open."""
+    """An HDF5 file for reading, also while its run still writes it: trajectories are written in
+    HDF5's single-writer/multiple-reader mode, read here in that mode (a frame appears once the
+    run has flushed it, every two seconds). Files of the older format open as plain files."""
     import h5py
 
-    return h5py.File(path, "r", locking=False)
+    try:
+        return h5py.File(path, "r", libver="latest", swmr=True)
+    except OSError:
+        return h5py.File(path, "r", locking=False)
 
 
 def read_json(path):

@@ -50,7 +50,8 @@ class TrajectoryOutput {
   void flush() {
     if (writer_) writer_->flush();
   }
-  // Every half minute, so that a killed run leaves readable frames.
+  // Every two seconds: a killed run leaves readable frames, and readers following the file
+  // (single-writer/multiple-reader mode) see a frame at most that late.
   void flush_now_and_then();
   H5mdWriter* writer() { return writer_.get(); }
   void close();

@@ -584,6 +584,10 @@ struct H5mdWriter::Impl {
   std::optional<Series> pairs, normal_force, tangential_force, sliding;
   long frames = 0;
   double max_diameter = 0;
+  // Single-writer/multiple-reader mode: readers (h5py with swmr=True, tools/rundir.py) follow the
+  // file while frames are appended. Entered once every dataset exists (after the first frame),
+  // left before the end of the run adds its tables (SWMR cannot create objects).
+  bool swmr = false, swmr_tried = false, frames_closed = false;
 
   ~Impl() {
     if (file.valid()) H5Fflush(file.get(), H5F_SCOPE_LOCAL);
@@ -601,6 +605,8 @@ struct H5mdWriter::Impl {
     return s;
   }
 
+  void start_swmr();
+  void leave_swmr();
   void create_suspension();
   void create_observables();
   void create_contacts();
@@ -672,6 +678,43 @@ void write_h5md_header(hid_t f, const fs::path& path, const TrajectoryLayout& la
 }
 
 }  // namespace
+
+namespace {
+
+// The latest file format: what single-writer/multiple-reader mode needs (HDF5 >= 1.10 reads it).
+Handle latest_format(const fs::path& path) {
+  Handle fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, path, "/", "cannot create fapl");
+  check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST), path, "/",
+        "cannot set the file format");
+  return fapl;
+}
+
+}  // namespace
+
+void H5mdWriter::Impl::start_swmr() {
+  if (swmr_tried) return;
+  swmr_tried = true;
+  // A trajectory begun in the older format (before this mode) is continued without it.
+  ErrorPrintGuard quiet;
+  swmr = H5Fstart_swmr_write(file.get()) >= 0;
+}
+
+// Closes every series and reopens the file for writing objects; no frame is written after.
+void H5mdWriter::Impl::leave_swmr() {
+  if (!swmr) return;
+  check(H5Fflush(file.get(), H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
+  for (Series* s : {&step, &time, &edges, &position, &velocity, &angular_velocity}) s->ds.reset();
+  for (auto* s : {&image, &unwrapped, &pairs, &normal_force, &tangential_force, &sliding})
+    s->reset();
+  observables.clear();
+  file.reset();
+  Handle fapl = latest_format(path);
+  ErrorPrintGuard quiet;
+  file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path, "/",
+                 "cannot reopen the trajectory to write its tables");
+  swmr = false;
+  frames_closed = true;
+}
 
 // /particles/suspension: the box, the position series (whose step and time every element
 // links), velocities where written, and the per-particle constants (species, motion, diameter).
@@ -772,7 +815,8 @@ H5mdWriter::H5mdWriter(const fs::path& path, const TrajectoryLayout& layout)
   for (double d : layout.diameter) m.max_diameter = std::max(m.max_diameter, d);
   {
     ErrorPrintGuard quiet;
-    m.file = checked(H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+    const Handle fapl = latest_format(path);
+    m.file = checked(H5Fcreate(path.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()),
                      H5Fclose, path, "/", "cannot create file");
   }
   write_h5md_header(m.file.get(), path, layout);
@@ -791,7 +835,13 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   for (double d : layout.diameter) m->max_diameter = std::max(m->max_diameter, d);
   {
     ErrorPrintGuard quiet;
-    m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose, path,
+    // A run killed while in single-writer/multiple-reader mode leaves the file marked as open
+    // for writing; the resumed run is its one writer again, so it clears the mark (what the
+    // HDF5 tool h5clear -s does, through the same file-access property).
+    const Handle fapl = latest_format(path);
+    hbool_t clear = true;
+    H5Pset(fapl.get(), "clear_status_flags", &clear);
+    m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path,
                       "/", "cannot reopen the trajectory to resume it");
   }
   const hid_t f = m->file.get();
@@ -824,6 +874,7 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   }
   m->frames = keep_frames;
   check(H5Fflush(f, H5F_SCOPE_LOCAL), path, "/", "cannot flush file");
+  if (keep_frames > 0) m->start_swmr();  // cut back first: SWMR cannot shrink a dataset
   return H5mdWriter(std::move(m));
 }
 
@@ -936,6 +987,7 @@ void H5mdWriter::Impl::append_contacts(const ContactNetwork& c) {
 void H5mdWriter::write_frame(const FrameData& frame) {
   if (!impl_) throw std::logic_error("H5mdWriter: write_frame on a moved-from writer");
   Impl& m = *impl_;
+  if (m.frames_closed) throw std::logic_error("H5mdWriter: write_frame after write_table");
   const std::size_t n = m.layout.n_particles;
   const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
   m.check_frame(frame, want_unwrapped);
@@ -966,12 +1018,14 @@ void H5mdWriter::write_frame(const FrameData& frame) {
     m.observables[k].append(H5T_NATIVE_DOUBLE, &frame.observables[k], m.path);
   if (m.layout.write_contacts) m.append_contacts(*frame.contacts);
   ++m.frames;
+  m.start_swmr();  // every dataset exists once the first frame is written
 }
 
 void H5mdWriter::write_table(const std::string& name, const std::vector<std::string>& columns,
                              const std::vector<std::string>& units, const Eigen::MatrixXd& values) {
   if (!impl_) throw std::logic_error("H5mdWriter: write_table on a moved-from writer");
   Impl& m = *impl_;
+  m.leave_swmr();
   check_name(name, m.path, "table");
   const std::string group_name = "/observables/" + name;
   if (columns.size() != static_cast<std::size_t>(values.cols()) || units.size() != columns.size()) {

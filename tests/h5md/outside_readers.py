@@ -8,7 +8,8 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
    of LAMMPS and GSD), in the H5MD file and in its GSD export (issue 34: the image used to be
    the one nearest the unwrapped position, which jumped by Lx once the shift gained since a
    crossing passed Lx/2);
-3. the GSD export (tools/h5md_to_gsd.py) read back with the gsd package: the box of every frame
+3. a trajectory read while its run writes it (HDF5 single-writer/multiple-reader mode);
+4. the GSD export (tools/h5md_to_gsd.py) read back with the gsd package: the box of every frame
    must be the H5MD one (Lx, Ly, tilt = xy Ly), and the minimum-image overlaps found under that
    box must be the simulation's (largest overlap at most the run's health limit, every pair of
    /connectivity/contacts within contact distance), while the same positions under the box
@@ -285,6 +286,61 @@ def check_plot_tools(root, work, runs):
                f"{tool} on a missing run: one line ({lines[:1]})")
 
 
+def check_live_reading(binary, root, work):
+    """A trajectory is read while its run writes it: in HDF5's single-writer/multiple-reader mode
+    (h5py with swmr=True, as tools/rundir.py opens files) the frames grow between two reads, the
+    last frame of the first read was whole (the second read finds it unchanged), and snapshot.py
+    draws the running run, which then stops cleanly on SIGTERM."""
+    import os
+    import signal
+    import time
+
+    cfg = work / "live.toml"
+    cfg.write_text(PRESSURE.replace("strain = 3.0", "strain = 400.0").replace("measure_strain = 0.6",
+                                                                              "measure_strain = 390.0"))
+    out = work / "live"
+    proc = subprocess.Popen([binary, "run", str(cfg), "--out", str(out), "-q"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    traj = out / "trajectory.h5"
+    counts, seen = [], []
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and len(counts) < 2 and proc.poll() is None:
+            time.sleep(2.5)
+            if not traj.is_file():
+                continue
+            try:
+                with h5py.File(traj, "r", libver="latest", swmr=True) as f:
+                    pos = f["particles/suspension/position/value"]
+                    frames = pos.shape[0]
+                    if frames == 0:
+                        continue
+                    last = pos[frames - 1]
+                    # The frame read last time, read again now: it was whole when first read.
+                    again = pos[counts[0] - 1] if counts else None
+            except OSError as e:
+                expect(False, f"live trajectory opens in SWMR mode ({e})")
+                break
+            expect(bool(np.all(np.isfinite(last)) and np.any(last != 0.0)),
+                   f"live frame {frames - 1}: finite positions, not the fill value")
+            if again is not None:
+                expect(np.array_equal(again, seen[0]),
+                       f"live frame {counts[0] - 1} read again later is the same")
+            counts.append(frames)
+            seen.append(last)
+        expect(proc.poll() is None, "the run is still running while it is read")
+        expect(len(counts) == 2 and counts[1] > counts[0],
+               f"frames grow between two reads of the running run ({counts})")
+        p = subprocess.run([sys.executable, str(root / "tools" / "snapshot.py"), str(out)],
+                           capture_output=True, text=True)
+        expect(p.returncode == 0, f"snapshot.py draws the running run ({p.stderr.strip()})")
+    finally:
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGTERM)
+        proc.wait()
+    expect(proc.returncode == 128 + signal.SIGTERM, f"the run stopped by SIGTERM (exit {proc.returncode})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -313,6 +369,7 @@ def main():
         check_gsd(args.root, pressure, False)
     check_continuity(args.root, run(args.bin, args.work, "simple_shear_long", LONG))
     check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
+    check_live_reading(args.bin, args.root, args.work)
     print(f"{len(failures)} failed")
     sys.exit(1 if failures else 0)
 
