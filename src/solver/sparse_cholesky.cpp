@@ -134,7 +134,7 @@ class Cholmod final : public SparseCholesky {
 void tune_cholmod(cholmod_common& c) {
   // The matrix is the contact graph of a 2D packing: nested dissection (CHOLMOD's NESDIS) gives
   // 20-27% fewer factorisation flops than AMD, and supernodes relaxed twice as far as CHOLMOD's
-  // defaults trade a few explicit zeros for fewer, larger BLAS calls. Together -19% per
+  // defaults trade a few explicit zeros for fewer, larger BLAS calls. Together -13 % and -11 % per
   // factorisation at N = 1000 and 4000 (bench/bench_solver, docs/performance.md); the costlier
   // analysis is paid once per neighbour rebuild.
   c.nmethods = 1;
