@@ -28,6 +28,8 @@ namespace {
 
 constexpr const char* kSuspension = "/particles/suspension";
 constexpr hsize_t kScalarChunk = 1024;
+constexpr hsize_t kChunkBytes = 256 * 1024;
+constexpr unsigned kDeflateLevel = 1;
 
 using Closer = herr_t (*)(hid_t);
 
@@ -234,6 +236,13 @@ Series create_series(hid_t loc, const std::string& full, hid_t file_type,
     maxdims[1] = H5S_UNLIMITED;
     chunk[1] = 512;
   }
+  // Many frames a chunk (about 256 KiB of a per-particle series), shuffled and deflated: a
+  // reader of one particle's history reads few chunks, and the file shrinks.
+  if (!inner.empty() && chunk_rows == 1) {
+    hsize_t row_bytes = H5Tget_size(file_type);
+    for (std::size_t k = 1; k < chunk.size(); ++k) row_bytes *= chunk[k];
+    chunk[0] = std::clamp<hsize_t>(kChunkBytes / std::max<hsize_t>(row_bytes, 1), 1, 64);
+  }
   Handle space = simple_space(dims, &maxdims, file, full);
   Handle dcpl =
       checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, file, full, "cannot create property list");
@@ -241,6 +250,8 @@ Series create_series(hid_t loc, const std::string& full, hid_t file_type,
         "cannot set chunking");
   if (fill != nullptr)
     check(H5Pset_fill_value(dcpl.get(), file_type, fill), file, full, "cannot set fill value");
+  check(H5Pset_shuffle(dcpl.get()), file, full, "cannot set the shuffle filter");
+  check(H5Pset_deflate(dcpl.get(), kDeflateLevel), file, full, "cannot set compression");
   Series s;
   s.ds = checked(
       H5Dcreate2(loc, full.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
