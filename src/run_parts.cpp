@@ -113,7 +113,8 @@ void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
   f.ly = d.height();
   f.tilt = d.box().le_offset;
   f.position = &d.particles().position;
-  f.unwrapped = &d.particles().unwrapped;
+  // Without Lees-Edwards the unwrapped position is position + image . edges: not stored twice.
+  if (d.box().lees_edwards) f.unwrapped = &d.particles().unwrapped;
   if (d.particles().image.size() == d.particles().size()) f.image = &d.particles().image;
   f.velocity = &run.sim.integrator().velocities().u;
   f.observables = values;

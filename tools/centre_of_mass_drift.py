@@ -25,11 +25,12 @@ def main():
         mobile = g["motion"][()] == 0
         d = g["diameter"][()][mobile]
         strain = f["observables/strain/value"][()]
-        vel, pos = g["velocity/value"], g["unwrapped_position/value"]
-        frames = range(0, min(vel.shape[0], pos.shape[0], len(strain)), a.every)
+        vel = g["velocity/value"]
+        frames = range(0, min(vel.shape[0], len(strain)), a.every)
+        pos = rundir.unwrapped_positions(g, list(frames))
         gammadot = strain[-1] / f["observables/strain/time"][-1]
         vy = np.array([(d * vel[k][mobile, 1]).sum() / d.sum() for k in frames])
-        yc = np.array([(d * pos[k][mobile, 1]).sum() / d.sum() for k in frames])
+        yc = np.array([(d * pos[j][mobile, 1]).sum() / d.sum() for j in range(len(frames))])
         t = np.array([strain[k] for k in frames])
         lx = float(f["particles/suspension/box/edges/value"][-1][0][0])
         drag = f["observables/net_drag_y/value"][()]

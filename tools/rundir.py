@@ -71,3 +71,16 @@ class Run:
     @property
     def config(self):
         return tomllib.loads(self.file("config").read_text()) if self.has("config") else {}
+
+
+def unwrapped_positions(group, frames=slice(None)):
+    """The unwrapped positions (frames x N x 2) of an H5MD particle group: stored under
+    Lees-Edwards, else position + image . edges (the pressure cell and the channel store no copy)."""
+    import numpy as np
+
+    if "unwrapped_position" in group:
+        return group["unwrapped_position/value"][frames]
+    pos = group["position/value"][frames]
+    img = group["image/value"][frames].astype(float)
+    edges = group["box/edges/value"][frames]
+    return pos + img[..., :1] * edges[:, None, 0, :] + img[..., 1:] * edges[:, None, 1, :]

@@ -621,15 +621,18 @@ struct H5mdWriter::Impl {
   void create_suspension();
   void create_observables();
   void create_contacts();
-  void check_frame(const FrameData& frame, bool want_unwrapped) const;
+  void check_frame(const FrameData& frame, bool want_images, bool want_unwrapped) const;
   void append_images(const FrameData& frame, double tilt, double ly);
   void append_velocity(const FrameData& frame);
   void append_contacts(const ContactNetwork& c);
 
-  void create_unwrapped() {
+  // The image counts of every particle, and its unwrapped position where that is not derivable
+  // from them (Lees-Edwards: x differs by the shift gained since each crossing).
+  void create_images(bool with_unwrapped) {
     const hsize_t n = layout.n_particles;
     image = element(susp("image"), H5T_STD_I32LE, {n, 2}, 1, kNumber);
-    unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, 2}, 1, kLength);
+    if (with_unwrapped)
+      unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, 2}, 1, kLength);
   }
 };
 
@@ -870,10 +873,10 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
     m->velocity = value(susp("velocity/value"), {n, 2});
     m->angular_velocity = value(susp("angular_velocity/value"), {n});
   }
-  if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0) {
+  if (H5Lexists(f, susp("image").c_str(), H5P_DEFAULT) > 0)
     m->image = value(susp("image/value"), {n, 2});
+  if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0)
     m->unwrapped = value(susp("unwrapped_position/value"), {n, 2});
-  }
   for (const auto& name : layout.observables)
     m->observables.push_back(value("/observables/" + name + "/value", {}));
   if (layout.write_contacts) {
@@ -895,7 +898,8 @@ H5mdWriter& H5mdWriter::operator=(H5mdWriter&&) noexcept = default;
 
 // Everything about a frame is checked before its first write, so a bad frame leaves the file
 // consistent.
-void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_unwrapped) const {
+void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_images,
+                                   bool want_unwrapped) const {
   const std::size_t n = layout.n_particles;
   const auto check_size = [&](std::size_t got, const std::string& name) {
     if (got != n) {
@@ -910,6 +914,9 @@ void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_unwrapped) 
     if (frame.velocity == nullptr) fail(path, susp("velocity"), "frame without velocities");
     check_size(frame.velocity->size(), susp("velocity"));
   }
+  if (want_images && frame.image == nullptr && frame.unwrapped == nullptr)
+    fail(path, susp("image"), "images were written at frame 0 but are missing now");
+  if (frame.image != nullptr) check_size(frame.image->size(), susp("image"));
   if (want_unwrapped) {
     if (frame.unwrapped == nullptr) {
       fail(path, susp("unwrapped_position"),
@@ -946,7 +953,6 @@ void H5mdWriter::Impl::append_images(const FrameData& frame, double tilt, double
   // engine's counts of the images crossed, re-expressed for the reduced tilt of `edges`
   // (tilt = offset - m lx adds m to the x count of each y image). It equals the unwrapped
   // position in y; in x the two differ by the Lees-Edwards shift gained since each crossing.
-  const std::vector<Vec2>& u = *frame.unwrapped;
   std::vector<std::int32_t> img(2 * n);
   const double m_tilt = layout.lees_edwards ? std::round(frame.tilt / lx) : 0.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -956,11 +962,14 @@ void H5mdWriter::Impl::append_images(const FrameData& frame, double tilt, double
       img[2 * i + 1] = static_cast<std::int32_t>(iy);
       continue;
     }
+    const std::vector<Vec2>& u = *frame.unwrapped;
     const double iy = layout.lees_edwards ? std::round((u[i].y() - pos[i].y()) / ly) : 0.0;
     img[2 * i] = static_cast<std::int32_t>(std::round((u[i].x() - pos[i].x() - iy * tilt) / lx));
     img[2 * i + 1] = static_cast<std::int32_t>(iy);
   }
   image->append(H5T_NATIVE_INT32, img.data(), path);
+  if (!unwrapped) return;
+  const std::vector<Vec2>& u = *frame.unwrapped;
   std::vector<double> buf(2 * n);
   for (std::size_t i = 0; i < n; ++i) buf[2 * i] = u[i].x(), buf[2 * i + 1] = u[i].y();
   unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), path);
@@ -1000,9 +1009,12 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   Impl& m = *impl_;
   if (m.frames_closed) throw std::logic_error("H5mdWriter: write_frame after write_table");
   const std::size_t n = m.layout.n_particles;
+  const bool want_images = m.frames == 0
+                               ? frame.image != nullptr || frame.unwrapped != nullptr
+                               : m.image.has_value();
   const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
-  m.check_frame(frame, want_unwrapped);
-  if (m.frames == 0 && want_unwrapped) m.create_unwrapped();
+  m.check_frame(frame, want_images, want_unwrapped);
+  if (m.frames == 0 && want_images) m.create_images(want_unwrapped);
 
   const std::vector<Vec2>& pos = *frame.position;
   const double lx = frame.lx;
@@ -1023,7 +1035,7 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   std::vector<double> buf(2 * n);
   for (std::size_t i = 0; i < n; ++i) buf[2 * i] = pos[i].x(), buf[2 * i + 1] = pos[i].y();
   m.position.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
-  if (m.unwrapped) m.append_images(frame, tilt, ly);
+  if (m.image) m.append_images(frame, tilt, ly);
   if (m.layout.write_velocity) m.append_velocity(frame);
   for (std::size_t k = 0; k < m.observables.size(); ++k)
     m.observables[k].append(H5T_NATIVE_DOUBLE, &frame.observables[k], m.path);
@@ -1202,7 +1214,15 @@ H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
     out.time = axis_value<double>(r, g + "/position/time", H5T_NATIVE_DOUBLE, idx);
   read_box(r, g, idx, out);
   const std::string unwrapped_name = g + "/unwrapped_position/value";
-  if (r.exists(unwrapped_name)) out.unwrapped = read_vectors(r, unwrapped_name, idx, n);
+  const std::string image_name = g + "/image/value";
+  if (r.exists(unwrapped_name)) {
+    out.unwrapped = read_vectors(r, unwrapped_name, idx, n);
+  } else if (r.exists(image_name) && !out.periodic_y) {
+    // Without Lees-Edwards the unwrapped position is position + image . edges (not stored).
+    out.unwrapped = read_vectors(r, image_name, idx, n);
+    for (std::size_t i = 0; i < n; ++i)
+      out.unwrapped[i] = out.position[i] + Vec2(out.unwrapped[i].x() * out.lx, 0.0);
+  }
   read_velocities(r, g, idx, n, out);
   read_per_particle(r, g, "diameter", H5T_NATIVE_DOUBLE, idx, n, out.diameter);
   read_per_particle(r, g, "species", H5T_NATIVE_INT, idx, n, out.species);
