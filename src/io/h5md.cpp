@@ -28,7 +28,6 @@ namespace {
 
 constexpr const char* kSuspension = "/particles/suspension";
 constexpr hsize_t kScalarChunk = 1024;
-constexpr hsize_t kChunkBytes = 256 * 1024;
 constexpr unsigned kDeflateLevel = 1;
 
 using Closer = herr_t (*)(hid_t);
@@ -236,13 +235,7 @@ Series create_series(hid_t loc, const std::string& full, hid_t file_type,
     maxdims[1] = H5S_UNLIMITED;
     chunk[1] = 512;
   }
-  // Many frames a chunk (about 256 KiB of a per-particle series), shuffled and deflated: a
-  // reader of one particle's history reads few chunks, and the file shrinks.
-  if (!inner.empty() && chunk_rows == 1) {
-    hsize_t row_bytes = H5Tget_size(file_type);
-    for (std::size_t k = 1; k < chunk.size(); ++k) row_bytes *= chunk[k];
-    chunk[0] = std::clamp<hsize_t>(kChunkBytes / std::max<hsize_t>(row_bytes, 1), 1, 64);
-  }
+
   Handle space = simple_space(dims, &maxdims, file, full);
   Handle dcpl =
       checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, file, full, "cannot create property list");
@@ -250,8 +243,15 @@ Series create_series(hid_t loc, const std::string& full, hid_t file_type,
         "cannot set chunking");
   if (fill != nullptr)
     check(H5Pset_fill_value(dcpl.get(), file_type, fill), file, full, "cannot set fill value");
-  check(H5Pset_shuffle(dcpl.get()), file, full, "cannot set the shuffle filter");
-  check(H5Pset_deflate(dcpl.get(), kDeflateLevel), file, full, "cannot set compression");
+  // Per-frame series are shuffled and deflated. Only they: each of their chunks (one frame) is
+  // written once, whereas a compressed chunk of many frames would be rewritten, to a new place,
+  // at every flush, and a kill between the write and the index update could lose frames a
+  // checkpoint already counts. The scalar series (many frames a chunk) are small and stay
+  // uncompressed, rewritten in place.
+  if (chunk_rows == 1) {
+    check(H5Pset_shuffle(dcpl.get()), file, full, "cannot set the shuffle filter");
+    check(H5Pset_deflate(dcpl.get(), kDeflateLevel), file, full, "cannot set compression");
+  }
   Series s;
   s.ds = checked(
       H5Dcreate2(loc, full.c_str(), file_type, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
