@@ -28,6 +28,7 @@
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
+#include "sheardiff/run_extension.hpp"
 #include "sheardiff/run_parts.hpp"
 #include "sheardiff/version.hpp"
 
@@ -58,48 +59,26 @@ struct StopSignals {
   }
 };
 
-// The resolved configuration as "section.key" -> value text, from to_toml's lines.
-std::map<std::string, std::string> config_entries(const std::string& toml_text) {
-  std::map<std::string, std::string> out;
-  std::istringstream in(toml_text);
-  std::string line, section;
-  while (std::getline(in, line)) {
-    if (line.empty() || line.front() == '#') continue;
-    if (line.front() == '[') {
-      section = line.substr(1, line.find(']') - 1);
-      continue;
-    }
-    const auto eq = line.find(" = ");
-    if (eq != std::string::npos) out[section + "." + line.substr(0, eq)] = line.substr(eq + 3);
-  }
-  return out;
-}
-
-// How DIR/config.toml differs from this resolved configuration, one "key: was -> now" each
-// (compared through the parser, so that keys added to the code since do not make it look
-// foreign); empty when it is the same.
-std::vector<std::string> config_changes(const std::filesystem::path& file,
-                                        const std::string& resolved) {
+// How DIR/config.toml differs from this resolved configuration, key by key (compared through
+// the parser, so that keys added to the code since do not make it look foreign); empty when it
+// is the same.
+std::vector<ConfigChange> changes_from(const std::filesystem::path& file,
+                                       const std::string& resolved) {
   std::string was;
   try {
     was = to_toml(load_config(file));
   } catch (const ConfigError& e) {
-    return {fmt::format("{} no longer reads as a configuration ({})", file.string(), e.what())};
+    return {{file.string(), "a configuration", fmt::format("unreadable ({})", e.what())}};
   }
-  if (was == resolved) return {};
-  const auto a = config_entries(was), b = config_entries(resolved);
-  std::vector<std::string> changes;
-  for (const auto& [key, value] : b) {
-    const auto it = a.find(key);
-    if (it == a.end())
-      changes.push_back(fmt::format("{}: not set -> {}", key, value));
-    else if (it->second != value)
-      changes.push_back(fmt::format("{}: {} -> {}", key, it->second, value));
-  }
-  for (const auto& [key, value] : a)
-    if (!b.count(key)) changes.push_back(fmt::format("{}: {} -> not set", key, value));
-  if (changes.empty()) changes.push_back("the files differ in form only");
+  auto changes = config_changes(was, resolved);
+  if (changes.empty() && was != resolved) changes.push_back({"(form)", "one text", "another"});
   return changes;
+}
+
+std::string listed(const std::vector<ConfigChange>& changes) {
+  std::vector<std::string> text;
+  for (const auto& c : changes) text.push_back(describe(c));
+  return fmt::format("{}", fmt::join(text, "; "));
 }
 
 std::string refusal(const RunDirectory& dir) {
@@ -146,6 +125,10 @@ std::string restart_would_lose(const RunDirectory& dir, const Config& cfg) {
       kept.push_back(fmt::format("{} (written when a run finishes)", name));
   if (fs::exists(dir.file(kReanalysisFolder), ec))
     kept.push_back("reanalysis/ (written by analyse on a finished run)");
+  if (fs::exists(dir.file(kFinalStateFile), ec))
+    kept.push_back(fmt::format("{} (a finished run's end)", kFinalStateFile));
+  if (fs::exists(dir.file(kEarlierFolder), ec))
+    kept.push_back("earlier/ (a finished run's results, kept when it was extended)");
   const auto traj = dir.file("trajectory.h5");
   if (cfg.output.checkpoint_strain > 0 && fs::exists(traj, ec)) {
     // A start killed before its first checkpoint has frames up to about that strain (one more
@@ -177,32 +160,53 @@ std::string restart_would_lose(const RunDirectory& dir, const Config& cfg) {
 
 namespace {
 
+// Where a run given DIR starts from.
+enum class Origin {
+  fresh,        // strain 0
+  checkpoint,   // DIR's checkpoint.bin (an interrupted run)
+  final_state,  // DIR's final_state.bin: a finished run extended to a further end
+  finished,     // nowhere: the run has finished and the configuration is the same
+};
+
 // What DIR holds decides what may be done (docs/stability.md, "Run directories"); nothing is
-// changed here. Returns whether the run continues from DIR's checkpoint; throws ConfigError for
-// a refused command.
-bool check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
-                     const std::string& resolved) {
+// changed here. Throws ConfigError for a refused command; `extending` is set when the run goes
+// on to a further end (only_moves_the_end).
+Origin check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
+                       const std::string& resolved, bool& extending) {
   const std::string out = dir.path().string();
   const RunState state = dir.state();
+  extending = false;
   if (mode == RunMode::start && state != RunState::empty) throw ConfigError(refusal(dir));
-  if (mode == RunMode::resume) {
-    if (state == RunState::empty)
-      throw ConfigError(fmt::format("--resume {}: there is no run there to resume", out));
-    if (state == RunState::started)
-      if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
-        throw ConfigError("--resume " + lost);
-    if (std::filesystem::exists(dir.file("config.toml")))
-      if (const auto changes = config_changes(dir.file("config.toml"), resolved); !changes.empty())
-        throw ConfigError(fmt::format(
-            "--resume {}: the configuration differs from the one the run was started with ({}; "
-            "see {}/config.toml)",
-            out, fmt::join(changes, "; "), out));
+  if (mode != RunMode::resume) return Origin::fresh;
+  if (state == RunState::empty)
+    throw ConfigError(fmt::format("--resume {}: there is no run there to resume", out));
+  if (state == RunState::started)
+    if (const auto lost = restart_would_lose(dir, cfg); !lost.empty())
+      throw ConfigError("--resume " + lost);
+  if (std::filesystem::exists(dir.file(kConfigFile))) {
+    const auto changes = changes_from(dir.file(kConfigFile), resolved);
+    extending = only_moves_the_end(changes) && state != RunState::started;
+    if (!changes.empty() && !extending)
+      throw ConfigError(fmt::format(
+          "--resume {}: the configuration differs from the one the run was started with ({}; "
+          "see {}/config.toml). Only a further end may be given to a run: a larger run.strain "
+          "or steady.measure_strain, a larger run.max_steps or 0",
+          out, listed(changes), out));
   }
-  return mode == RunMode::resume && state == RunState::interrupted;
+  if (state == RunState::interrupted) return Origin::checkpoint;
+  if (state != RunState::finished) return Origin::fresh;
+  if (!extending) return Origin::finished;
+  if (!std::filesystem::exists(dir.file(kFinalStateFile)))
+    throw ConfigError(fmt::format(
+        "--resume {}: the run finished without keeping its final state ({}; an earlier "
+        "sheardiff removed it), so it cannot be extended; nothing was changed. Run the longer "
+        "run into another directory",
+        out, kFinalStateFile));
+  return Origin::final_state;
 }
 
-// --resume of a finished run: a run killed between its summary and the removal of its
-// checkpoint is finished; say so, complete the removal and return its summary.
+// --resume of a finished run with the same configuration: a run killed between its summary and
+// the removal of its checkpoint is finished; say so, complete the removal and return its summary.
 nlohmann::json finished_run_summary(RunDirectory& dir) {
   dir.start_log("resume of a finished run: " + this_command_line());
   std::error_code ec;
@@ -217,14 +221,17 @@ nlohmann::json finished_run_summary(RunDirectory& dir) {
   }
 }
 
-// The directory is taken over: a new run starts from nothing of an earlier one.
+// The directory is taken over: a new run starts from nothing of an earlier one; an extended
+// one records its new end in config.toml (the earlier one is kept: set_aside_finished_results,
+// or run.log for an interrupted run).
 void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool checksummed,
-                     const std::string& resolved) {
+                     const std::string& resolved, const std::string& extension) {
   if (from_checkpoint)
     dir.remove_partial_files();
   else
     dir.remove_run_files(/*keep_log=*/mode == RunMode::resume);
   dir.start_log(this_command_line());
+  if (!extension.empty()) std::fprintf(stderr, "%s\n", extension.c_str());
   if (from_checkpoint && !checksummed)
     std::fprintf(stderr,
                  "warning: %s has no checksum (written by an older sheardiff): resumed unchecked\n",
@@ -234,7 +241,7 @@ void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool
                  "%s: no checkpoint was written before the run stopped: starting again "
                  "from strain 0\n",
                  dir.path().c_str());
-  if (!from_checkpoint) {
+  if (!from_checkpoint || !extension.empty()) {
     write_file_atomically(dir.file("config.toml"), resolved);
   } else if (!std::filesystem::exists(dir.file("config.toml"))) {
     // The checkpoint holds the run's config and has been checked against this one: a deleted
@@ -248,9 +255,13 @@ void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool
 // The end of the run. Every write replaces what an earlier attempt may have written (tables,
 // analysis.h5, summary.json), so a death anywhere in it resumes from the last checkpoint and
 // completes; summary.json, written last, marks the run finished.
-nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seconds,
-                          RunDirectory& dir, TrajectoryOutput& trajectory) {
-  nlohmann::json js = run_summary(cfg, run, wall_seconds, dir, trajectory);
+nlohmann::json finish_run(const Config& cfg, RunningState& run, double elapsed_now,
+                          RunDirectory& dir, TrajectoryOutput& trajectory,
+                          const CheckpointStore& checkpoints) {
+  nlohmann::json js = run_summary(cfg, run, run.elapsed_before + elapsed_now, dir, trajectory);
+  // The state at the end, kept so that the run can be extended (written before the summary:
+  // a finished run always has it).
+  checkpoints.save(run, elapsed_now, trajectory, dir.file(kFinalStateFile));
   trajectory.close();
   // channel.h5's writer does not check its file's close (analysis.h5's does since it throws on
   // a failed flush or close): a full disk there would leave a truncated file under the final
@@ -265,7 +276,8 @@ nlohmann::json finish_run(const Config& cfg, RunningState& run, double wall_seco
     }
   }
   write_file_atomically(dir.file("summary.json"), json_text(js) + "\n");
-  // Finished: the summary marks the run complete and the checkpoint has served its purpose.
+  // Finished: the summary marks the run complete and the checkpoint has served its purpose
+  // (final_state.bin holds the end).
   std::filesystem::remove(dir.file("checkpoint.bin"));
   return js;
 }
@@ -274,6 +286,32 @@ std::int64_t unix_seconds_now() {
   return std::chrono::duration_cast<std::chrono::seconds>(
              std::chrono::system_clock::now().time_since_epoch())
       .count();
+}
+
+}  // namespace
+
+namespace {
+
+// An extension goes on from where the run is; a finished run's results are set aside first
+// (refused, with nothing changed, when the new end is no further than where the run stopped).
+std::string extension_note(const Config& cfg, const RunningState& run, RunDirectory& dir,
+                           bool finished) {
+  const double strain = run.sim.dynamics().strain();
+  if (run.finished(cfg))
+    throw ConfigError(fmt::format(
+        "--resume {}: the run would stop where it is (strain {:.6g}): give a further end (for "
+        "a pressure cell that has found its steady state, steady.measure_strain sets it)",
+        dir.path().string(), strain));
+  if (!finished)
+    return fmt::format(
+        "extended: the run goes on from strain {:.6g} to its new end (strain "
+        "{:.6g}); config.toml holds the new configuration",
+        strain, run.planned_end_strain(cfg));
+  const auto kept = set_aside_finished_results(dir, strain);
+  return fmt::format(
+      "extended: the finished run goes on from strain {:.6g} to its new end "
+      "(strain {:.6g}); what it wrote when it finished is kept in {}",
+      strain, run.planned_end_strain(cfg), kept.string());
 }
 
 }  // namespace
@@ -398,22 +436,27 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   Config cfg = given;
   resolve_defaults(cfg);
   const std::string resolved = to_toml(cfg);
-  const bool from_checkpoint = check_directory(dir, mode, cfg, resolved);
-  if (mode == RunMode::resume && dir.state() == RunState::finished)
-    return finished_run_summary(dir);
+  bool extending = false;
+  const Origin origin = check_directory(dir, mode, cfg, resolved, extending);
+  if (origin == Origin::finished) return finished_run_summary(dir);
+  const bool from_checkpoint = origin == Origin::checkpoint || origin == Origin::final_state;
   const CheckpointStore checkpoints(dir.file("checkpoint.bin"), resolved, dir.path().string());
   CheckpointPayload payload;
-  if (from_checkpoint) payload = read_checkpoint_file(checkpoints.file());
+  if (from_checkpoint)
+    payload = read_checkpoint_file(
+        dir.file(origin == Origin::final_state ? kFinalStateFile : kCheckpointFile));
   // The initial state is built (and the checkpoint read) before anything is written: a bad
   // input file leaves no output.
   const bool checksummed = payload.checksummed;
   RunningState run(cfg, dir.path(), started);
   if (from_checkpoint) checkpoints.load(run, std::move(payload));
-  claim_directory(dir, mode, from_checkpoint, checksummed, resolved);
+  const std::string extension =
+      extending ? extension_note(cfg, run, dir, origin == Origin::final_state) : "";
+  claim_directory(dir, mode, from_checkpoint, checksummed, resolved, extension);
   TrajectoryOutput trajectory(cfg, run, dir, resolved, from_checkpoint);
   RunProgress progress_lines(dir, progress, progress_seconds, run.sim.dynamics());
   StepLoop(cfg, run, dir, checkpoints, trajectory, progress_lines).run_to_the_end();
-  return finish_run(cfg, run, run.elapsed_before + progress_lines.elapsed(), dir, trajectory);
+  return finish_run(cfg, run, progress_lines.elapsed(), dir, trajectory, checkpoints);
 } catch (const IoError& e) {
   if (!dir.logging()) throw;
   rethrow_with_advice(dir, e);

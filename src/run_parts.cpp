@@ -14,6 +14,7 @@
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/observe/profiles.hpp"
+#include "sheardiff/run_extension.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/version.hpp"
 
@@ -147,7 +148,8 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, int layout) const
   const bool with_counters = layout >= 3;
   std::string config = resolved_;
   a.io(config);
-  if (!same_config_text(config, resolved_))
+  // An extended run's checkpoint was written with the run's earlier end.
+  if (!same_config_text(config, resolved_) && !only_moves_the_end(config, resolved_))
     throw ConfigError(fmt::format(
         "--resume {}: the configuration differs from the one the checkpoint was written with "
         "(see {}/config.toml)",
@@ -202,8 +204,8 @@ void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
   if (!a.at_end()) unreadable_checkpoint(file_, "bytes are left after the state");
 }
 
-void CheckpointStore::save(RunningState& run, double elapsed_now,
-                           TrajectoryOutput& trajectory) const {
+void CheckpointStore::save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory,
+                           const std::filesystem::path& to) const {
   trajectory.flush();  // the trajectory holds every frame the checkpoint counts
   Archive a = Archive::writer();
   double total = run.elapsed_before + elapsed_now;
@@ -212,7 +214,7 @@ void CheckpointStore::save(RunningState& run, double elapsed_now,
   std::swap(total, run.elapsed_before);
   // Whole or absent: a checkpoint is never half-written.
   const std::vector<char> bytes = checkpoint_file_bytes(a.bytes());
-  write_file_atomically(file_, bytes.data(), bytes.size());
+  write_file_atomically(to.empty() ? file_ : to, bytes.data(), bytes.size());
 }
 
 // ---- RunProgress ---------------------------------------------------------------------------

@@ -28,12 +28,17 @@ class RunDirectory;
 //   resume     continue DIR's run: from its checkpoint; from strain 0 if it stopped before
 //              its first one (refused when DIR holds more than such a start leaves:
 //              restart_would_lose); a finished run is left as it is (its checkpoint, if a death
-//              left one behind, removed) and its summary returned.
+//              left one behind, removed) and its summary returned. Given a configuration
+//              whose only changes move the run's end further (only_moves_the_end), the run is
+//              extended: an interrupted one from its checkpoint, a finished one from its
+//              final_state.bin after its results are set aside in earlier/
+//              (set_aside_finished_results); steps, time and the analysis go on.
 enum class RunMode { start, overwrite, resume };
 
 // Runs cfg to its end in the locked directory `dir`, writing trajectory.h5 (H5MD), config.toml,
 // checkpoint.bin every output.checkpoint_strain, run.log, and at the end summary.json (whose
-// presence marks a finished run; the checkpoint is then removed). A resumed run cuts the
+// presence marks a finished run; the checkpoint is then removed and the end state kept as
+// final_state.bin). A resumed run cuts the
 // trajectory back to the checkpoint's frames and continues bit-identically to a run never
 // stopped. Nothing in DIR is changed before the configuration, the initial state and the
 // checkpoint have been checked. Throws ConfigError (exit 2: refused, nothing changed), IoError

@@ -67,11 +67,13 @@ class CheckpointStore {
  public:
   CheckpointStore(std::filesystem::path file, std::string resolved_config, std::string out_dir)
       : file_(std::move(file)), resolved_(std::move(resolved_config)), out_(std::move(out_dir)) {}
-  // Throws ConfigError (another configuration) or CorruptCheckpoint.
+  // Throws ConfigError (another configuration, but one that only moves the run's end) or
+  // CorruptCheckpoint.
   void load(RunningState& run, CheckpointPayload payload) const;
   // elapsed_now: seconds this process has run; the trajectory is flushed first so that it holds
-  // every frame the checkpoint counts.
-  void save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory) const;
+  // every frame the checkpoint counts. To file() unless another file is given (the final state).
+  void save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory,
+            const std::filesystem::path& to = {}) const;
   const std::filesystem::path& file() const { return file_; }
 
  private:

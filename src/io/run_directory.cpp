@@ -96,7 +96,8 @@ const std::vector<std::string>& run_file_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n = {kConfigFile, kTrajectoryFile};
     n.insert(n.end(), kAnalyserFiles.begin(), kAnalyserFiles.end());
-    for (const char* f : {kSummaryFile, kCheckpointFile, kDiagnosticFile, kLog, kReanalysisFolder})
+    for (const char* f : {kSummaryFile, kCheckpointFile, kFinalStateFile, kDiagnosticFile, kLog,
+                          kReanalysisFolder, kEarlierFolder})
       n.emplace_back(f);
     return n;
   }();
@@ -310,7 +311,7 @@ void RunDirectory::remove_run_files(bool keep_log) {
     for (const auto& f : {name, name + ".tmp"}) {
       if (keep_log && f == kLog) continue;
       std::error_code ec;
-      fs::remove_all(file(f), ec);  // reanalysis/ is a folder (analyse's output)
+      fs::remove_all(file(f), ec);  // reanalysis/ and earlier/ are folders
       if (ec) throw IoError(fmt::format("cannot remove {}: {}", file(f).string(), ec.message()));
     }
   }

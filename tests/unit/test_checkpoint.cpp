@@ -222,6 +222,73 @@ void make_interrupted_run(const fs::path& cfg, const fs::path& dir) {
   ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
 }
 
+// A finished run extended to a larger strain (--resume with a larger run.strain) is, to the
+// bit, the run that was started with that strain: the end is only tested, never anticipated.
+// What it had written when it finished is kept in earlier/end_strain=S/.
+TEST(Checkpoint, ExtendedRunIsTheLongerRunToTheBit) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_extend";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  ASSERT_EQ(wait_exit(spawn(cfg, root / "direct")), 0);
+  ASSERT_EQ(
+      wait_exit(spawn_run(cfg, {"--out", (root / "ext").string(), "--set", "run.strain=1.2"})), 0);
+  ASSERT_TRUE(fs::exists(root / "ext" / "final_state.bin")) << "a finished run keeps its end";
+  nlohmann::json first;
+  std::ifstream(root / "ext" / "summary.json") >> first;
+  const fs::path err = root / "err.txt";
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "ext", {}, err)), 0) << text_of(err);
+  EXPECT_NE(text_of(err).find("extended: the finished run goes on from strain"), std::string::npos)
+      << text_of(err);
+  expect_same_final_state(root / "direct", root / "ext");
+  EXPECT_EQ(text_of(root / "ext" / "config.toml"), text_of(root / "direct" / "config.toml"));
+  // The earlier results, unchanged.
+  std::vector<fs::path> kept;
+  for (const auto& e : fs::directory_iterator(root / "ext" / "earlier")) kept.push_back(e.path());
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].filename().string().rfind("end_strain=1.2", 0), 0u) << kept[0];
+  nlohmann::json earlier;
+  std::ifstream(kept[0] / "summary.json") >> earlier;
+  EXPECT_EQ(earlier, first);
+  EXPECT_TRUE(fs::exists(kept[0] / "analysis.h5"));
+  EXPECT_NE(text_of(kept[0] / "config.toml").find("strain = 1.2"), std::string::npos);
+  fs::remove_all(root);
+}
+
+// Only the end may change: another J is refused naming the key, a shorter end and an end the
+// run has passed are refused, a run finished without its final state cannot be extended; each
+// refusal (exit 2) leaves the directory as it was. An interrupted run may be given a further end.
+TEST(Checkpoint, ExtensionOnlyMovesTheEnd) {
+  const fs::path root = fs::temp_directory_path() / "sheardiff_test_extend_refused";
+  fs::remove_all(root);
+  const fs::path cfg = write_config(root);
+  const fs::path dir = root / "run", err = root / "err.txt";
+  ASSERT_EQ(wait_exit(spawn(cfg, dir)), 0);
+  const auto summary = bytes_of(dir / "summary.json");
+  const auto expect_refused = [&](const std::vector<std::string>& set, const std::string& says) {
+    EXPECT_EQ(wait_exit(spawn_resume(cfg, dir, set, err)), 2) << says;
+    EXPECT_NE(text_of(err).find(says), std::string::npos) << text_of(err);
+    EXPECT_EQ(bytes_of(dir / "summary.json"), summary);
+    EXPECT_FALSE(fs::exists(dir / "earlier"));
+  };
+  expect_refused({"--set", "flow.J=0.1", "--set", "run.strain=3"}, "flow.J: 0.03 -> 0.1");
+  expect_refused({"--set", "run.strain=1.5"}, "run.strain: 2.0 -> 1.5");
+  // The pressure cell stops at steady + measure_strain when that comes first.
+  expect_refused({"--set", "steady.measure_strain=0.5", "--set", "run.strain=3"},
+                 "steady.measure_strain");
+  fs::remove(dir / "final_state.bin");
+  expect_refused({"--set", "run.strain=3"}, "without keeping its final state");
+  // An interrupted run goes on to its new end, which config.toml then holds.
+  make_interrupted_run(cfg, root / "int");
+  ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "int", {"--set", "run.strain=2.5"}, err)), 0)
+      << text_of(err);
+  EXPECT_NE(text_of(err).find("extended: the run goes on"), std::string::npos) << text_of(err);
+  nlohmann::json js;
+  std::ifstream(root / "int" / "summary.json") >> js;
+  EXPECT_NEAR(js["strain"].get<double>(), 2.5, 0.01);
+  EXPECT_NE(text_of(root / "int" / "config.toml").find("strain = 2.5"), std::string::npos);
+  fs::remove_all(root);
+}
+
 // A finished run whose summary.json was deleted, or one whose checkpoint.bin was, looked like a
 // start killed before its first checkpoint: --resume deleted its analysis and rewrote its whole
 // trajectory from strain 0. It must be refused (exit 2) with every file left as it was.

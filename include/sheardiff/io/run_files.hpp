@@ -18,5 +18,9 @@ inline constexpr const char* kSummaryFile = "summary.json";
 inline constexpr const char* kCheckpointFile = "checkpoint.bin";
 inline constexpr const char* kDiagnosticFile = "diagnostic.txt";
 inline constexpr const char* kReanalysisFolder = "reanalysis";
+// A finished run's state at its end (a checkpoint), from which it can be extended.
+inline constexpr const char* kFinalStateFile = "final_state.bin";
+// Where an extension keeps what the run had written when it finished: earlier/end_strain=S/.
+inline constexpr const char* kEarlierFolder = "earlier";
 
 }  // namespace sheardiff
