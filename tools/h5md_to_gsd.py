@@ -41,27 +41,10 @@ def new_frame():
 
 
 def export(h5_path, out):
-    import h5py
-
-    with rundir.open_h5(h5_path) as f:
-        groups = list(f["particles"])
-        name = "suspension" if "suspension" in groups else groups[0]
-        g = f["particles"][name]
-        pos = g["position/value"][()]
-        n_frames, n = pos.shape[:2]
-        edges = g["box/edges/value"][()]
-        if edges.ndim == 2:  # a cuboid box (files before the triclinic layout)
-            edges = np.stack([np.diag(e) for e in edges])
-        boundary = [b.decode() if isinstance(b, bytes) else str(b) for b in g["box"].attrs["boundary"]]
-        periodic_y = boundary[1] == "periodic"
-        image = g["image/value"][()] if "image" in g else np.zeros(pos.shape, np.int64)
-        vel = g["velocity/value"][()] if "velocity" in g else None
-        diam = g["diameter"][()]
-        species = g["species"][()] if "species" in g else np.zeros(n, int)
-        motion = g["motion"][()] if "motion" in g else np.zeros(n, int)
-        steps = g["position/step"][()]
-        obs = {k: f["observables"][k]["value"][()] for k in f.get("observables", {})
-               if isinstance(f["observables"][k], h5py.Group) and "step" in f["observables"][k]}
+    t = rundir.read_trajectory(h5_path)
+    pos, edges, image, vel, diam = t["position"], t["edges"], t["image"], t["velocity"], t["diameter"]
+    species, motion, steps, obs, periodic_y = t["species"], t["motion"], t["step"], t["observables"], t["periodic_y"]
+    n_frames, n = pos.shape[:2]
     typeid = np.where(motion == 0, species, motion + 1).astype(np.uint32)
     dmax = float(diam.max())
     if not periodic_y:

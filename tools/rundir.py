@@ -84,3 +84,34 @@ def unwrapped_positions(group, frames=slice(None)):
     img = group["image/value"][frames].astype(float)
     edges = group["box/edges/value"][frames]
     return pos + img[..., :1] * edges[:, None, 0, :] + img[..., 1:] * edges[:, None, 1, :]
+
+
+def read_trajectory(path):
+    """The whole trajectory of an H5MD file (a run's trajectory.h5, finished or running) as numpy
+    arrays, for the exporters: position, image (frames x N x 2), velocity (or None), edges (frames
+    x 2 x 2: rows are the box vectors, the Lees-Edwards tilt in edges[:, 1, 0]), periodic_y,
+    diameter, species, motion (N), step, time (frames) and the scalar observables by name."""
+    import h5py
+    import numpy as np
+
+    with open_h5(path) as f:
+        groups = list(f["particles"])
+        g = f["particles"]["suspension" if "suspension" in groups else groups[0]]
+        t = {"position": g["position/value"][()]}
+        n = t["position"].shape[1]
+        edges = g["box/edges/value"][()]
+        if edges.ndim == 2:  # a cuboid box (files before the triclinic layout)
+            edges = np.stack([np.diag(e) for e in edges])
+        t["edges"] = edges
+        boundary = [b.decode() if isinstance(b, bytes) else str(b) for b in g["box"].attrs["boundary"]]
+        t["periodic_y"] = boundary[1] == "periodic"
+        t["image"] = g["image/value"][()] if "image" in g else np.zeros(t["position"].shape, np.int64)
+        t["velocity"] = g["velocity/value"][()] if "velocity" in g else None
+        t["diameter"] = g["diameter"][()]
+        t["species"] = g["species"][()] if "species" in g else np.zeros(n, int)
+        t["motion"] = g["motion"][()] if "motion" in g else np.zeros(n, int)
+        t["step"] = g["position/step"][()]
+        t["time"] = g["position/time"][()]
+        t["observables"] = {k: f["observables"][k]["value"][()] for k in f.get("observables", {})
+                            if isinstance(f["observables"][k], h5py.Group) and "step" in f["observables"][k]}
+    return t

@@ -13,7 +13,8 @@ PKGS=(build-essential cmake ninja-build pkg-config
       strace      # the ctest run_dir_final_phase_kill (tests/cli/final_phase_kill.sh)
       clang-14 libclang-rt-14-dev  # libFuzzer for the ctest fuzz_config_smoke (tests/fuzz/)
       python3 python3-numpy python3-scipy python3-matplotlib python3-h5py
-      python3-gsd)  # the GSD export (tools/h5md_to_gsd.py) and its ctest h5md_outside_readers
+      python3-gsd  # the GSD export (tools/h5md_to_gsd.py) and its ctest h5md_outside_readers
+      python3-mdanalysis)  # reads the LAMMPS dump export (tools/h5md_to_lammps.py) in that ctest
 
 missing=()
 for p in "${PKGS[@]}"; do

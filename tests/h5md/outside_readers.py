@@ -13,7 +13,9 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
    must be the H5MD one (Lx, Ly, tilt = xy Ly), and the minimum-image overlaps found under that
    box must be the simulation's (largest overlap at most the run's health limit, every pair of
    /connectivity/contacts within contact distance), while the same positions under the box
-   without its tilt show the false overlaps across the y edges that the tilt removes.
+   without its tilt show the false overlaps across the y edges that the tilt removes;
+5. the LAMMPS dump export (tools/h5md_to_lammps.py) read by MDAnalysis: positions, velocities and
+   box as h5py reads them, the unwrapped positions continuous.
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -244,6 +246,47 @@ def check_continuity(root, traj):
                              f"(largest move per frame {gstep:.3f} d)")
 
 
+def check_mdanalysis(root, traj, periodic_y):
+    """MDAnalysis (Debian's python3-mdanalysis) reads the LAMMPS dump export
+    (tools/h5md_to_lammps.py): every frame's positions equal h5py's (to float32, MDAnalysis's
+    precision), its box vectors the H5MD edges (tilt included), its velocities h5py's, and with
+    lammps_coordinate_convention="unwrapped" the positions equal position + image . edges and
+    are continuous over the run's Lees-Edwards crossings."""
+    import warnings
+
+    warnings.simplefilter("ignore")  # MDAnalysis guesses masses, Python 3.11 deprecations
+    import MDAnalysis as mda
+
+    out = traj.with_suffix(".lammpstrj.gz")
+    subprocess.run([sys.executable, str(root / "tools" / "h5md_to_lammps.py"), str(traj), "--out", str(out)],
+                   check=True, capture_output=True)
+    with h5py.File(traj, "r") as f:
+        g = f["particles/suspension"]
+        pos, vel = g["position/value"][()], g["velocity/value"][()]
+        img, edges = g["image/value"][()].astype(np.float64), g["box/edges/value"][()]
+    unw = pos + img[:, :, :1] * edges[:, None, 0, :] + img[:, :, 1:] * edges[:, None, 1, :]
+    name = traj.parent.name
+    for convention, want in (("auto", pos), ("unwrapped", unw)):
+        u = mda.Universe(str(out), format="LAMMPSDUMP", lammps_coordinate_convention=convention)
+        expect(len(u.trajectory) == len(pos), f"{name}: MDAnalysis reads {len(pos)} frames ({len(u.trajectory)})")
+        worst_pos = worst_box = worst_vel = 0.0
+        for k, ts in enumerate(u.trajectory):
+            worst_pos = max(worst_pos, np.abs(ts.positions[:, :2] - want[k].astype(np.float32)).max(),
+                            np.abs(ts.positions[:, 2]).max())
+            worst_vel = max(worst_vel, np.abs(ts.velocities[:, :2] - vel[k].astype(np.float32)).max())
+            worst_box = max(worst_box, np.abs(ts.triclinic_dimensions[:2, :2] - edges[k]).max()
+                            if periodic_y else abs(ts.triclinic_dimensions[0, 0] - edges[k, 0, 0]))
+        expect(worst_pos == 0.0, f"{name} ({convention}): MDAnalysis's positions are h5py's as float32 "
+                                 f"(largest difference {worst_pos:.3g})")
+        expect(worst_vel == 0.0, f"{name}: MDAnalysis's velocities are h5py's as float32 ({worst_vel:.3g})")
+        # The box goes through lengths and angles in float32 in MDAnalysis.
+        expect(worst_box < 1e-6 * edges[:, 0, 0].max(),
+               f"{name}: MDAnalysis's box vectors are the H5MD edges (largest difference {worst_box:.3g})")
+    moves = np.abs(np.diff(unw, axis=0)).max()
+    expect(moves < 0.1 * edges[0, 0, 0], f"{name}: the unwrapped positions MDAnalysis reads are continuous "
+                                         f"(largest move per frame {moves:.3f} d)")
+
+
 def check_plot_run_numbers(root, run_dir):
     """plot_run.py shows a finished pressure-cell run's own means and error bars (issue 34: it
     recomputed them from a later window, with the spread of correlated frames as the error)."""
@@ -367,7 +410,15 @@ def main():
     else:
         check_gsd(args.root, simple, True)
         check_gsd(args.root, pressure, False)
-    check_continuity(args.root, run(args.bin, args.work, "simple_shear_long", LONG))
+    long = run(args.bin, args.work, "simple_shear_long", LONG)
+    check_continuity(args.root, long)
+    try:
+        import MDAnalysis  # noqa: F401
+    except ImportError:
+        expect(False, "MDAnalysis (python3-mdanalysis, tools/setup.sh) is installed")
+    else:
+        check_mdanalysis(args.root, long, True)
+        check_mdanalysis(args.root, pressure, False)
     check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
     check_live_reading(args.bin, args.root, args.work)
     print(f"{len(failures)} failed")
