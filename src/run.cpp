@@ -335,8 +335,10 @@ class StepLoop {
   void run_to_the_end() {
     Simulation& sim = run_.sim;
     Dynamics& d = sim.dynamics();
+    if (d.steps() == 0 && run_.frames == 0) frame_at_rest();
     while (!run_.finished(cfg_)) {
       if (const int sig = g_stop_signal.load()) stop_on_signal(sig);
+      d.set_landing(run_.next_frame);
       if (!sim.try_step()) stop(run_.health.solver_failure(d, sim.integrator().velocities()));
       if (auto r = run_.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
         stop(*r);
@@ -357,19 +359,33 @@ class StepLoop {
   }
 
  private:
+  // The frame at step 0: the initial configuration with its velocities and stresses at rest
+  // (solved, nothing moved). Observers give its values; none takes it as a sample of the flow.
+  void frame_at_rest() {
+    Simulation& sim = run_.sim;
+    if (!sim.solve_at_rest())
+      stop(run_.health.solver_failure(sim.dynamics(), sim.integrator().velocities()));
+    const StressSample s = sim.sample_at_rest();
+    write_frame(StepView{sim.dynamics(), sim.integrator().velocities(), s, 0.0});
+  }
+
   // A frame: observers add their values, the trajectory writes it, a checkpoint may follow.
   void output_frame(const StepView& view) {
     const Dynamics& d = run_.sim.dynamics();
     run_.next_frame = next_output_strain(run_.next_frame, cfg_.output.frame_strain, d.strain());
-    values_.clear();
-    for (const auto& o : run_.observers) o->on_frame(view, values_);
-    trajectory_.write_frame(cfg_, run_, values_);
-    ++run_.frames;
+    write_frame(view);
     if (cfg_.output.checkpoint_strain > 0.0 && d.strain() >= run_.next_checkpoint * (1.0 - 1e-12)) {
       run_.next_checkpoint =
           next_output_strain(run_.next_checkpoint, cfg_.output.checkpoint_strain, d.strain());
       checkpoints_.save(run_, progress_.elapsed(), trajectory_);
     }
+  }
+
+  void write_frame(const StepView& view) {
+    values_.clear();
+    for (const auto& o : run_.observers) o->on_frame(view, values_);
+    trajectory_.write_frame(cfg_, run_, values_);
+    ++run_.frames;
   }
 
   [[noreturn]] void stop_on_signal(int sig) {

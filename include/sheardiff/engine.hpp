@@ -23,6 +23,12 @@ class Simulation {
   // One integrator step; false if the linear solve failed (the state is then unchanged).
   bool try_step() { return integrator_->step(*dynamics_); }
   StressSample sample() const { return integrator_->sample(*dynamics_, cfg_.flow.lz); }
+  // Velocities and stresses at the configuration as it is before the first step (the frame at
+  // step 0); false if the solve failed. Integrator::solve_at_rest.
+  bool solve_at_rest() { return integrator_->solve_at_rest(*dynamics_); }
+  StressSample sample_at_rest() const {
+    return measure_stress(*dynamics_, integrator_->velocities(), cfg_.flow.lz);
+  }
 
   const Config& config() const { return cfg_; }
   Dynamics& dynamics() { return *dynamics_; }

@@ -83,6 +83,13 @@ double Dynamics::fixed_step() const {
   return rest > 0.0 && rest < limits_.fixed_dt ? rest : limits_.fixed_dt;
 }
 
+double Dynamics::landed(double dt) const {
+  const double rate = flow_.clock_rate();
+  if (landing_ <= 0.0 || rate <= 0.0) return dt;
+  const double to_go = landing_ / rate - time_;
+  return to_go > 0.0 && dt >= to_go ? to_go : dt;
+}
+
 double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   StepLimit why = StepLimit::Fixed;
   const auto take = [&](double cand, double& dt, StepLimit l) {

@@ -13,7 +13,7 @@ bool ExplicitEuler::step(Dynamics& d) {
   if (!d.solve(0.0, last_)) return false;
   ++solves_;
   StepLimit why;
-  dt_ = d.dt_limit(last_, &why);
+  dt_ = d.landed(d.dt_limit(last_, &why));
   d.count_step_limit(why);
   d.advance(dt_, last_);
   d.finish_step();
@@ -25,7 +25,7 @@ bool Heun::step(Dynamics& d) {
   if (!d.solve(0.0, predictor_)) return false;
   ++solves_;
   StepLimit why;
-  dt_ = d.dt_limit(predictor_, &why);
+  dt_ = d.landed(d.dt_limit(predictor_, &why));
   d.count_step_limit(why);
   predictor_terms_ = d.force_balance().terms();
   const Dynamics::Saved start = d.save();
@@ -36,7 +36,8 @@ bool Heun::step(Dynamics& d) {
   corrector_terms_ = d.force_balance().terms();
   d.restore(start);
   if (!ok) return false;
-  for (std::size_t i = 0; i < last_.u.size(); ++i) last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
+  for (std::size_t i = 0; i < last_.u.size(); ++i)
+    last_.u[i] = 0.5 * (last_.u[i] + predictor_.u[i]);
   last_.wall_v = 0.5 * (last_.wall_v + predictor_.wall_v);
   // The wall load holds in the mean sample only if it held at both stages.
   last_.wall_free_fall = last_.wall_free_fall || predictor_.wall_free_fall;
@@ -55,6 +56,10 @@ bool ImplicitSprings::step(Dynamics& d) {
     ++solves_;
     dt = d.dt_limit(last_);
   }
+  // The step the limits chose, before it is shortened to land on a frame: the next one grows
+  // from it, so that landing costs one short step and no slow regrowth.
+  double wanted = dt;
+  if (!fixed) dt = d.landed(dt);
   StepLimit why = fixed ? StepLimit::Fixed : limit_of_next_;
   for (int attempt = 0;; ++attempt) {
     if (!d.solve(dt, last_)) return false;
@@ -75,11 +80,12 @@ bool ImplicitSprings::step(Dynamics& d) {
     StepLimit now;
     const double allowed = d.dt_limit(last_, &now);
     if (dt <= overshoot_ * allowed || attempt == 3) {
-      next_dt_ = std::min(growth_ * dt, allowed);
-      limit_of_next_ = growth_ * dt < allowed ? StepLimit::Growth : now;
+      next_dt_ = std::min(growth_ * wanted, allowed);
+      limit_of_next_ = growth_ * wanted < allowed ? StepLimit::Growth : now;
       break;
     }
-    dt = allowed;
+    wanted = allowed;
+    dt = d.landed(allowed);
     why = now;
     ++redos_;
   }
@@ -92,9 +98,12 @@ bool ImplicitSprings::step(Dynamics& d) {
 
 std::unique_ptr<Integrator> make_integrator(IntegratorType type) {
   switch (type) {
-    case IntegratorType::Euler: return std::make_unique<ExplicitEuler>();
-    case IntegratorType::Heun: return std::make_unique<Heun>();
-    case IntegratorType::Implicit: return std::make_unique<ImplicitSprings>();
+    case IntegratorType::Euler:
+      return std::make_unique<ExplicitEuler>();
+    case IntegratorType::Heun:
+      return std::make_unique<Heun>();
+    case IntegratorType::Implicit:
+      return std::make_unique<ImplicitSprings>();
   }
   return nullptr;
 }

@@ -34,7 +34,9 @@ struct Outcome {
   long steps = 0;
 };
 
-Outcome run(const std::string& scene, int steps) {
+// at_rest_first: the run's frame at step 0 solves at the configuration as it is before the first
+// step (Simulation::solve_at_rest); the run must go on exactly as without it.
+Outcome run(const std::string& scene, int steps, bool at_rest_first = false) {
   Config cfg;
   cfg.scene.type = scene;
   cfg.particles.n = 60;
@@ -45,6 +47,9 @@ Outcome run(const std::string& scene, int steps) {
   cfg.contact.ktilde = 1e4;
   cfg.solver.cholesky = "eigen";
   Simulation sim(cfg);
+  if (at_rest_first) {
+    EXPECT_TRUE(sim.solve_at_rest());
+  }
   for (int k = 0; k < steps; ++k) EXPECT_TRUE(sim.try_step()) << scene << " step " << k;
   const Dynamics& d = sim.dynamics();
   std::vector<double> x, u;
@@ -52,11 +57,11 @@ Outcome run(const std::string& scene, int steps) {
   for (const Vec3& v : sim.integrator().velocities().u) u.insert(u.end(), {v.x(), v.y(), v.z()});
   const StressSample s = sim.sample();
   Outcome o{fnv1a(x), fnv1a(u), d.strain(), s.shear_stress(), s.pressure(), d.steps()};
-  std::printf("%s: %d contacts; positions %#llx velocities %#llx strain %.17g shear %.17g "
-              "pressure %.17g\n",
-              scene.c_str(), s.contacts, static_cast<unsigned long long>(o.positions),
-              static_cast<unsigned long long>(o.velocities), o.strain, o.shear_stress,
-              o.pressure);
+  std::printf(
+      "%s: %d contacts; positions %#llx velocities %#llx strain %.17g shear %.17g "
+      "pressure %.17g\n",
+      scene.c_str(), s.contacts, static_cast<unsigned long long>(o.positions),
+      static_cast<unsigned long long>(o.velocities), o.strain, o.shear_stress, o.pressure);
   return o;
 }
 
@@ -76,6 +81,17 @@ TEST(ReferenceRuns, PressureShearIsBitIdenticalToTheRecordedRun) {
   EXPECT_EQ(o.strain, 0.70970149350100098);
   EXPECT_EQ(o.shear_stress, 0.36479319275908451);
   EXPECT_EQ(o.pressure, 0.74649563187191026);
+}
+
+TEST(ReferenceRuns, TheFrameAtRestLeavesTheRunsUnchanged) {
+  for (const char* scene : {"simple_shear", "pressure_shear"}) {
+    const int steps = std::string(scene) == "simple_shear" ? 400 : 3000;
+    const Outcome a = run(scene, steps), b = run(scene, steps, true);
+    EXPECT_EQ(a.positions, b.positions) << scene;
+    EXPECT_EQ(a.velocities, b.velocities) << scene;
+    EXPECT_EQ(a.strain, b.strain) << scene;
+    EXPECT_EQ(a.shear_stress, b.shear_stress) << scene;
+  }
 }
 
 }  // namespace

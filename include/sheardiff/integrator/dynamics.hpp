@@ -58,6 +58,11 @@ class Dynamics {
   double dt_limit(const Velocities& v, StepLimit* which = nullptr) const;
   // fixed_dt, shortened on the last step so that a run ends exactly at limits().end_time.
   double fixed_step() const;
+  // A step chosen by the limits, shortened to end exactly at the landing clock (a strain) if it
+  // would reach or pass it: the run's next frame, so that frames are evenly spaced. A step that
+  // ends short of it is left as it is; none is set (0) by default, and never with a fixed dt.
+  void set_landing(double clock) { landing_ = clock; }
+  double landed(double dt) const;
   // Integrators report the limit that set each step they take.
   void count_step_limit(StepLimit l) { ++limit_counts_[static_cast<int>(l)]; }
   const std::array<long, static_cast<int>(StepLimit::Count)>& step_limit_counts() const {
@@ -120,6 +125,7 @@ class Dynamics {
   StepLimits limits_;
   std::optional<WallBodies> walls_;
   double time_ = 0.0;
+  double landing_ = 0.0;  // on the run's clock; not part of the state (the step loop sets it)
   long steps_ = 0;
   bool rebuild_due_ = false;
   std::array<long, static_cast<int>(StepLimit::Count)> limit_counts_{};

@@ -13,7 +13,15 @@ class Integrator {
   virtual ~Integrator() = default;
   // Advance one step. Returns false if a linear solve failed (state is then unchanged).
   virtual bool step(Dynamics& d) = 0;
-  // Velocities of the last completed step (the ones the particles moved with).
+  // The velocities at the configuration as it is, springs explicit, nothing moved: the state
+  // of the frame at step 0. The next step solves again from the same configuration, so a run
+  // steps as it would without this call. false if the solve failed.
+  bool solve_at_rest(Dynamics& d) {
+    d.begin_step();
+    return d.solve(0.0, last_);
+  }
+  // Velocities of the last completed step (the ones the particles moved with), or those of
+  // solve_at_rest before the first step.
   const Velocities& velocities() const { return last_; }
   double last_dt() const { return dt_; }
   long solves() const { return solves_; }
