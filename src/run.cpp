@@ -75,10 +75,33 @@ std::vector<ConfigChange> changes_from(const std::filesystem::path& file,
   return changes;
 }
 
-std::string listed(const std::vector<ConfigChange>& changes) {
-  std::vector<std::string> text;
-  for (const auto& c : changes) text.push_back(describe(c));
-  return fmt::format("{}", fmt::join(text, "; "));
+// The changes for a message: those the user made, then, named apart, the keys that follow from
+// them (a key whose new value the others give when it is left to resolve_defaults, e.g.
+// output.frame_strain after a change of flow.J).
+std::string listed(const std::vector<ConfigChange>& changes, const std::filesystem::path& file) {
+  std::vector<std::string> made, follow;
+  for (const auto& c : changes) {
+    std::vector<std::string> others{c.key + "=0"};
+    for (const auto& o : changes)
+      if (o.key != c.key && !o.now.empty()) others.push_back(o.key + "=" + o.now);
+    bool derived = false;
+    try {
+      const auto again = config_changes(to_toml(load_config(file, others)), "");
+      derived =
+          !c.now.empty() && std::any_of(again.begin(), again.end(), [&](const ConfigChange& a) {
+            return a.key == c.key && a.was == c.now;
+          });
+    } catch (const ConfigError&) {
+    }
+    (derived ? follow : made).push_back(derived ? c.key : describe(c));
+  }
+  if (made.empty() || follow.empty()) {
+    made.clear();
+    for (const auto& c : changes) made.push_back(describe(c));
+    return fmt::format("{}", fmt::join(made, "; "));
+  }
+  return fmt::format("{}; and, following from them, {}", fmt::join(made, "; "),
+                     fmt::join(follow, ", "));
 }
 
 std::string refusal(const RunDirectory& dir) {
@@ -191,7 +214,7 @@ Origin check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
           "--resume {}: the configuration differs from the one the run was started with ({}; "
           "see {}/config.toml). Only a further end may be given to a run: a larger run.strain "
           "or steady.measure_strain, a larger run.max_steps or 0",
-          out, listed(changes), out));
+          out, listed(changes, dir.file(kConfigFile)), out));
   }
   if (state == RunState::interrupted) return Origin::checkpoint;
   if (state != RunState::finished) return Origin::fresh;

@@ -78,6 +78,9 @@ expect 0 "no checkpoint was written before the run stopped: starting again from 
 # that changed with its old and new value.
 expect 2 "the configuration differs from the one the run was started with (" -- run run.toml --resume int --set flow.J=0.05
 grep -qF "flow.J: 0.01 -> 0.05" cmd.err || fail "the refusal does not name flow.J: $(cat cmd.err)"
+# Keys that follow from a change (here output.frame_strain left to J, and the sample spacing
+# derived from it) are named apart from the change the user made.
+expect 2 "(flow.J: 0.01 -> 0.05; and, following from them, analysis.sample_strain, output.frame_strain;" -- run run.toml --resume int --set flow.J=0.05 --set output.frame_strain=0
 # Nothing to resume.
 mkdir empty
 expect 2 "--resume empty: there is no run there to resume" -- run run.toml --resume empty
