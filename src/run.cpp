@@ -10,6 +10,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -84,13 +85,14 @@ std::string listed(const std::vector<ConfigChange>& changes, const std::filesyst
     std::vector<std::string> others{c.key + "=0"};
     for (const auto& o : changes)
       if (o.key != c.key && !o.now.empty()) others.push_back(o.key + "=" + o.now);
+    // Only a key that resolve_defaults fills in (0 = derived) can follow from the others.
     bool derived = false;
     try {
       const auto again = config_changes(to_toml(load_config(file, others)), "");
-      derived =
-          !c.now.empty() && std::any_of(again.begin(), again.end(), [&](const ConfigChange& a) {
-            return a.key == c.key && a.was == c.now;
-          });
+      derived = !c.now.empty() && std::strtod(c.now.c_str(), nullptr) != 0.0 &&
+                std::any_of(again.begin(), again.end(), [&](const ConfigChange& a) {
+                  return a.key == c.key && a.was == c.now;
+                });
     } catch (const ConfigError&) {
     }
     (derived ? follow : made).push_back(derived ? c.key : describe(c));
@@ -315,6 +317,20 @@ std::int64_t unix_seconds_now() {
 
 namespace {
 
+// A finished run's end state, read to extend it: an unreadable one leaves the finished run as it
+// is (the advice to start again with --overwrite, right for a checkpoint, would delete it).
+void load_final_state(RunningState& run, CheckpointPayload payload, const RunDirectory& dir,
+                      const std::string& resolved) {
+  try {
+    CheckpointStore(dir.file(kFinalStateFile), resolved, dir.path().string())
+        .load(run, std::move(payload));
+  } catch (const CorruptCheckpoint& e) {
+    throw CorruptCheckpoint(
+        fmt::format("{}: the run cannot be extended; the finished run is left as it is ({})",
+                    dir.file(kFinalStateFile).string(), e.what()));
+  }
+}
+
 // An extension goes on from where the run is; a finished run's results are set aside first
 // (refused, with nothing changed, when the new end is no further than where the run stopped).
 std::string extension_note(const Config& cfg, const RunningState& run, RunDirectory& dir,
@@ -330,6 +346,19 @@ std::string extension_note(const Config& cfg, const RunningState& run, RunDirect
         "extended: the run goes on from strain {:.6g} to its new end (strain "
         "{:.6g}); config.toml holds the new configuration",
         strain, run.planned_end_strain(cfg));
+  // The trajectory must be there to be continued: checked before anything is moved.
+  if (cfg.output.trajectory) {
+    long frames = -1;
+    try {
+      frames = count_h5md_frames(dir.file(kTrajectoryFile));
+    } catch (const std::exception&) {
+    }
+    if (frames < run.frames)
+      throw ConfigError(fmt::format(
+          "--resume {}: {} is missing or holds fewer frames than the finished run wrote ({}), so "
+          "the run cannot be extended; nothing was changed",
+          dir.path().string(), kTrajectoryFile, run.frames));
+  }
   const auto kept = set_aside_finished_results(dir, strain);
   return fmt::format(
       "extended: the finished run goes on from strain {:.6g} to its new end "
@@ -488,7 +517,10 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   // input file leaves no output.
   const bool checksummed = payload.checksummed;
   RunningState run(cfg, dir.path(), started);
-  if (from_checkpoint) checkpoints.load(run, std::move(payload));
+  if (origin == Origin::final_state)
+    load_final_state(run, std::move(payload), dir, resolved);
+  else if (from_checkpoint)
+    checkpoints.load(run, std::move(payload));
   const std::string extension =
       extending ? extension_note(cfg, run, dir, origin == Origin::final_state) : "";
   claim_directory(dir, mode, from_checkpoint, checksummed, resolved, extension);

@@ -112,7 +112,11 @@ bool only_moves_the_end(const std::string& was, const std::string& now) {
 fs::path set_aside_finished_results(RunDirectory& dir, double end_strain) {
   // The checkpoint first: from here on, whatever stops this, DIR can be resumed.
   write_file_atomically(dir.file(kCheckpointFile), file_bytes(dir.file(kFinalStateFile)));
-  const fs::path to = dir.file(kEarlierFolder) / fmt::format("end_strain={:.6g}", end_strain);
+  // A folder of its own: two ends may print alike ({:.6g}); one whose summary is not yet there
+  // is this extension's own, begun by a command that was killed.
+  fs::path to = dir.file(kEarlierFolder) / fmt::format("end_strain={:.6g}", end_strain);
+  for (int k = 2; fs::exists(to / kSummaryFile); ++k)
+    to = dir.file(kEarlierFolder) / fmt::format("end_strain={:.6g}_{}", end_strain, k);
   std::error_code ec;
   fs::create_directories(to, ec);
   if (ec) throw IoError(fmt::format("cannot make {}: {}", to.string(), ec.message()));

@@ -23,8 +23,9 @@ h5py reads), the edges Lx, Ly and the tilt xy of the frame. The third dimension 
 in LAMMPS's own 2D dumps: z = 0 and a z extent of one diameter, [0, 1]. Types: 1 small, 2 large,
 3 fixed_wall, 4 floating_wall, 5 driven_wall. The pressure cell is not periodic in y: its y
 boundary is LAMMPS's fixed one (`pp ff pp`), and, as in the trajectory, its y edge is the
-packing's height H, from which the wall particles stick out. Lengths are in d and times in 1/gammadot (docs/units.md), as LAMMPS's
-`units lj` leaves them: the file states no unit (MDAnalysis will call them Angstrom and ps).
+packing's height H, from which the wall particles stick out. Lengths are in d and times in
+1/gammadot (the channel: a and a/<u>; docs/units.md), as LAMMPS's `units lj` leaves them: the
+file states no unit (MDAnalysis will call them Angstrom and ps).
 """
 import argparse
 import gzip

@@ -85,7 +85,7 @@ double Dynamics::fixed_step() const {
 
 double Dynamics::landed(double dt) const {
   const double rate = flow_.clock_rate();
-  if (landing_ <= 0.0 || rate <= 0.0) return dt;
+  if (limits_.fixed_dt > 0.0 || landing_ <= 0.0 || rate <= 0.0) return dt;
   const double to_go = landing_ / rate - time_;
   return to_go > 0.0 && dt >= to_go ? to_go : dt;
 }

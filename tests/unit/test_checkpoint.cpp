@@ -264,17 +264,25 @@ TEST(Checkpoint, ExtensionOnlyMovesTheEnd) {
   const fs::path dir = root / "run", err = root / "err.txt";
   ASSERT_EQ(wait_exit(spawn(cfg, dir)), 0);
   const auto summary = bytes_of(dir / "summary.json");
+  const auto config = bytes_of(dir / "config.toml");
   const auto expect_refused = [&](const std::vector<std::string>& set, const std::string& says) {
     EXPECT_EQ(wait_exit(spawn_resume(cfg, dir, set, err)), 2) << says;
     EXPECT_NE(text_of(err).find(says), std::string::npos) << text_of(err);
     EXPECT_EQ(bytes_of(dir / "summary.json"), summary);
+    EXPECT_EQ(bytes_of(dir / "config.toml"), config);
+    EXPECT_TRUE(fs::exists(dir / "analysis.h5"));
     EXPECT_FALSE(fs::exists(dir / "earlier"));
+    EXPECT_FALSE(fs::exists(dir / "checkpoint.bin"));
   };
   expect_refused({"--set", "flow.J=0.1", "--set", "run.strain=3"}, "flow.J: 0.03 -> 0.1");
   expect_refused({"--set", "run.strain=1.5"}, "run.strain: 2.0 -> 1.5");
   // The pressure cell stops at steady + measure_strain when that comes first.
   expect_refused({"--set", "steady.measure_strain=0.5", "--set", "run.strain=3"},
-                 "steady.measure_strain");
+                 "the run would stop where it is");
+  // The trajectory it would continue is checked before anything is moved.
+  fs::rename(dir / "trajectory.h5", root / "trajectory.h5");
+  expect_refused({"--set", "run.strain=3"}, "is missing or holds fewer frames");
+  fs::rename(root / "trajectory.h5", dir / "trajectory.h5");
   fs::remove(dir / "final_state.bin");
   expect_refused({"--set", "run.strain=3"}, "without keeping its final state");
   // An interrupted run goes on to its new end, which config.toml then holds.

@@ -98,7 +98,10 @@ class Dynamics {
   // Mutable access for set-up and tests (e.g. external forces); positions changed here take
   // effect at the next rebuild, so call rebuild_now() after moving particles.
   Particles& particles_mut() { return particles_; }
-  void rebuild_now() { rebuild(); }
+  void rebuild_now() {
+    rebuild();
+    rebuild_due_ = false;
+  }
   const Box& box() const { return box_; }
   const ImposedFlow& flow() const { return flow_; }
   const NeighbourList& neighbours() const { return neighbours_; }
