@@ -119,6 +119,34 @@ KeySpec choice(std::string key, std::vector<std::string> choices, std::string do
                  std::move(set)};
 }
 
+// The keys a section declares itself (a pair law's XParams::declare), turned into schema rows.
+template <typename T>
+struct SectionKeys {
+  std::vector<KeySpec>& rows;
+  T Config::*section;
+  void real(std::string key, double T::*field, double lo, double hi, bool lo_open, std::string unit,
+            std::string doc, bool hi_open = false) {
+    rows.push_back(sheardiff::real(std::move(key), section, field, lo, hi, lo_open, std::move(unit),
+                                   std::move(doc), hi_open));
+  }
+  void boolean(std::string key, bool T::*field, std::string doc) {
+    rows.push_back(sheardiff::boolean(std::move(key), section, field, std::move(doc)));
+  }
+  void choice(std::string key, std::vector<std::string> choices, std::string T::*field,
+              std::string doc) {
+    auto sec = section;
+    rows.push_back(sheardiff::choice(
+        std::move(key), std::move(choices), std::move(doc),
+        [sec, field](const Config& c) { return Value{c.*sec.*field}; },
+        [sec, field](Config& c, const Value& v) { c.*sec.*field = std::get<std::string>(v); }));
+  }
+};
+template <typename T>
+void declare_section(std::vector<KeySpec>& rows, T Config::*section) {
+  SectionKeys<T> keys{rows, section};
+  T::declare(keys);
+}
+
 const std::vector<KeySpec>& schema() {
   using C = Config;
   static const std::vector<KeySpec> specs = [] {
@@ -166,42 +194,9 @@ const std::vector<KeySpec>& schema() {
                      "Viscous number; in model units this is the shear rate gammadot."));
     s.push_back(real("flow.lz", &C::flow, &C::Flow::lz, 0.0, 100.0, true, "d",
                      "Thickness given to the monolayer for stresses and the wall load P Lx lz."));
-    s.push_back(boolean("lubrication.enabled", &C::lubrication, &C::Lubrication::enabled,
-                        "Pairwise lubrication and lubrication-matched contact dashpots."));
-    // The squeeze resistance at contact grows as 1/delta: at delta = 1e-20 the resistance
-    // matrix is no longer positive definite in double precision (measured, issue 16).
-    s.push_back(real("lubrication.delta", &C::lubrication, &C::Lubrication::delta, 1e-10, 0.5,
-                     false, "1 (reduced gap)", "Regularisation of the lubrication singularity."));
-    s.push_back(real("lubrication.h_max", &C::lubrication, &C::Lubrication::h_max, 0.0, 1.0, true,
-                     "1 (reduced gap)",
-                     "Lubrication cut-off: active for 0 < h < h_max (must be < 1).",
-                     /*hi_open=*/true));
-    s.push_back(boolean("lubrication.tangential", &C::lubrication, &C::Lubrication::tangential,
-                        "Tangential lubrication modes (shear, shear-rotation, pump); off = squeeze "
-                        "only. Off with mu = 0: no rotational unknowns (2 per particle)."));
-    s.push_back(real("contact.ktilde", &C::contact, &C::Contact::ktilde, 1.0, 1e9, false,
-                     "P d (so kn = ktilde)", "Normal contact stiffness kn / (P d)."));
-    s.push_back(real("contact.kt_ratio", &C::contact, &C::Contact::kt_ratio, 0.0, 1.0, false, "",
-                     "Tangential over normal stiffness kt / kn."));
-    s.push_back(real("contact.mu", &C::contact, &C::Contact::mu, 0.0, 10.0, false, "",
-                     "Coulomb friction coefficient (0 = frictionless, no tangential springs)."));
-    s.push_back(choice(
-        "contact.stiffness", {"uniform", "mean_radius"},
-        "Per-pair stiffness: `uniform` (every pair kn, kt) or `mean_radius` (LF_DEM's "
-        "convention: kn, kt times (a_i + a_j) / d, so 1.2x for small-large and 1.4x for "
-        "large-large pairs at size_ratio 1.4).",
-        [](const C& c) { return Value{c.contact.stiffness}; },
-        [](C& c, const Value& v) { c.contact.stiffness = std::get<std::string>(v); }));
-    s.push_back(
-        real("repulsion.F0", &C::repulsion, &C::Repulsion::f0, 0.0, 1e4, false, "P d^2",
-             "Electrostatic double-layer repulsion F0 exp(-h / lambda) between the "
-             "surfaces (h the gap, along the line of centres; F0 when touching); 0 = off."));
-    s.push_back(real("repulsion.lambda", &C::repulsion, &C::Repulsion::lambda, 0.0, 0.5, true, "d",
-                     "Debye length lambda of the double-layer repulsion."));
-    s.push_back(real("repulsion.cutoff", &C::repulsion, &C::Repulsion::cutoff, 1.0, 20.0, false,
-                     "lambda",
-                     "Gap, in Debye lengths, beyond which the repulsion is cut "
-                     "(where it has fallen to exp(-cutoff) F0)."));
+    declare_section(s, &C::lubrication);
+    declare_section(s, &C::contact);
+    declare_section(s, &C::repulsion);
     s.push_back(choice(
         "integrator.type", {"implicit", "euler", "heun"},
         "Spring integration: `implicit` (linearly implicit springs, dt set by accuracy), "
@@ -456,8 +451,8 @@ std::string range_text(const KeySpec& k) {
       return fmt::format("a number in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo, k.hi,
                          k.hi_open ? ")" : "]");
     case Kind::RealList:
-      return fmt::format("a list of numbers in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo,
-                         k.hi, k.hi_open ? ")" : "]");
+      return fmt::format("a list of numbers in {}{:g}, {:g}{}", k.lo_open ? "(" : "[", k.lo, k.hi,
+                         k.hi_open ? ")" : "]");
   }
   return "";
 }
@@ -478,8 +473,7 @@ std::string describe(const toml::node& n) {
     os << '[';
     for (std::size_t i = 0; i < a->size(); ++i) os << (i ? ", " : "") << describe(*a->get(i));
     os << ']';
-  }
-  else
+  } else
     n.visit([&](const auto& v) { os << v; });
   return os.str();
 }

@@ -8,6 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "sheardiff/interactions/contact_params.hpp"
+#include "sheardiff/interactions/lubrication_params.hpp"
+#include "sheardiff/interactions/repulsion_params.hpp"
+
 namespace sheardiff {
 
 enum class IntegratorType { Implicit, Euler, Heun };
@@ -33,23 +37,10 @@ struct Config {
     double j = 1e-2;  // viscous number = gammadot in units P/eta
     double lz = 1.0;  // monolayer thickness for stresses and wall load
   } flow;
-  struct Lubrication {
-    bool enabled = true;
-    double delta = 0.01;
-    double h_max = 0.5;
-    bool tangential = true;  // shear, shear-rotation and pump modes (off: squeeze only)
-  } lubrication;
-  struct Contact {
-    double ktilde = 1e4;
-    double kt_ratio = 0.5;
-    double mu = 0.5;
-    std::string stiffness = "uniform";  // or "mean_radius" (kn, kt x (a_i + a_j) / d)
-  } contact;
-  struct Repulsion {
-    double f0 = 0.0;       // P d^2; 0 = off
-    double lambda = 0.02;  // Debye length, d
-    double cutoff = 10.0;  // in Debye lengths
-  } repulsion;
+  // The pair laws' sections: each law declares its keys with its parameters.
+  LubricationParams lubrication;
+  ContactParams contact;
+  RepulsionParams repulsion;
   struct Integrator {
     IntegratorType type = IntegratorType::Implicit;
     double dt = 0.0;  // 0 = adaptive
@@ -89,10 +80,10 @@ struct Config {
     double steady_tolerance = 0.02;    // of the centreline distance, between window halves
   } channel;
   struct Steady {
-    double window = 2.0;          // strain window of the no-drift test
-    double h_tolerance = 0.01;    // relative drift of H allowed between the window halves
-    double mu_tolerance = 0.05;   // drift of mu allowed between the window halves
-    double measure_strain = 0.0;  // strain run after steady state (0 = until run.strain)
+    double window = 2.0;                // strain window of the no-drift test
+    double h_tolerance = 0.01;          // relative drift of H allowed between the window halves
+    double mu_tolerance = 0.05;         // drift of mu allowed between the window halves
+    double measure_strain = 0.0;        // strain run after steady state (0 = until run.strain)
     double drift_z = 3.0;               // standard errors a window's drift signals may reach
     double bulk_load_tolerance = 0.05;  // of P, for the bulk's -sigma_yy
   } steady;
@@ -102,14 +93,14 @@ struct Config {
     bool profiles = true;         // profiles across the gap (scenes with walls)
   } observables;
   struct Analysis {
-    bool diffusion = true;        // MSD, VACF, dv, Psi, D over the measured window
-    double msd_window_lo = 8.0;   // strain
-    double msd_window_hi = 15.0;  // strain
-    std::int64_t reference_times = 1000;  // unused: every sample is an origin
-    double vacf_max_lag = 2.0;  // strain
-    double error_block = 3.0;   // strain: time blocks of the error bars
-    double sample_strain = 0.0;  // strain between samples; 0 = output.frame_strain / 10
-    double coarse_strain = 0.0;  // strain between the samples D comes from; 0 = auto
+    bool diffusion = true;                   // MSD, VACF, dv, Psi, D over the measured window
+    double msd_window_lo = 8.0;              // strain
+    double msd_window_hi = 15.0;             // strain
+    std::int64_t reference_times = 1000;     // unused: every sample is an origin
+    double vacf_max_lag = 2.0;               // strain
+    double error_block = 3.0;                // strain: time blocks of the error bars
+    double sample_strain = 0.0;              // strain between samples; 0 = output.frame_strain / 10
+    double coarse_strain = 0.0;              // strain between the samples D comes from; 0 = auto
     std::vector<double> velocity_intervals;  // strain: displacement-velocity definitions
   } analysis;
   struct Output {

@@ -1,7 +1,8 @@
 #pragma once
 // The pair laws of the engine and the generic operations over them (pair_law.hpp has the
-// contract). A new law is its header plus its config rows and one entry in PairLaws below (and,
-// if it keeps a per-contact history, one member of PairHistory).
+// contract). A new law is its header and its parameters header (NAME_params.hpp: its keys,
+// declared once), one member of Config, one declare_section line and one entry in PairLaws below
+// (and, if it keeps a per-contact history, one member of PairHistory).
 #include <algorithm>
 #include <optional>
 #include <tuple>

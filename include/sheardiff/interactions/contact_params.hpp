@@ -1,0 +1,31 @@
+#pragma once
+// The frictional contact law's parameters and their keys, declared once: the configuration
+// schema, its validation and docs/config.md read them from here (interactions/contact.hpp is
+// the law).
+#include <string>
+
+namespace sheardiff {
+
+struct ContactParams {
+  double ktilde = 1e4;
+  double kt_ratio = 0.5;
+  double mu = 0.5;
+  std::string stiffness = "uniform";  // or "mean_radius" (kn, kt x (a_i + a_j) / d)
+
+  // Keys: the schema's section adapter (src/config.cpp), with real / boolean / choice.
+  template <class Keys>
+  static void declare(Keys& k) {
+    k.real("contact.ktilde", &ContactParams::ktilde, 1.0, 1e9, false, "P d (so kn = ktilde)",
+           "Normal contact stiffness kn / (P d).");
+    k.real("contact.kt_ratio", &ContactParams::kt_ratio, 0.0, 1.0, false, "",
+           "Tangential over normal stiffness kt / kn.");
+    k.real("contact.mu", &ContactParams::mu, 0.0, 10.0, false, "",
+           "Coulomb friction coefficient (0 = frictionless, no tangential springs).");
+    k.choice("contact.stiffness", {"uniform", "mean_radius"}, &ContactParams::stiffness,
+             "Per-pair stiffness: `uniform` (every pair kn, kt) or `mean_radius` (LF_DEM's "
+             "convention: kn, kt times (a_i + a_j) / d, so 1.2x for small-large and 1.4x for "
+             "large-large pairs at size_ratio 1.4).");
+  }
+};
+
+}  // namespace sheardiff
