@@ -129,6 +129,16 @@ struct SectionKeys {
     rows.push_back(sheardiff::real(std::move(key), section, field, lo, hi, lo_open, std::move(unit),
                                    std::move(doc), hi_open));
   }
+  void integer(std::string key, std::int64_t T::*field, double lo, double hi, std::string unit,
+               std::string doc) {
+    rows.push_back(sheardiff::integer(std::move(key), section, field, lo, hi, std::move(unit),
+                                      std::move(doc)));
+  }
+  void real_list(std::string key, std::vector<double> T::*field, double lo, double hi, bool lo_open,
+                 std::string unit, std::string doc) {
+    rows.push_back(sheardiff::real_list(std::move(key), section, field, lo, hi, lo_open,
+                                        std::move(unit), std::move(doc)));
+  }
   void boolean(std::string key, bool T::*field, std::string doc) {
     rows.push_back(sheardiff::boolean(std::move(key), section, field, std::move(doc)));
   }
@@ -297,25 +307,7 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("channel.steady_tolerance", &C::channel, &C::Channel::steady_tolerance, 0.0,
                      1.0, true, "",
                      "channel: relative drift allowed (see channel.steady_window)."));
-    s.push_back(real("steady.window", &C::steady, &C::Steady::window, 0.0, 1e4, true, "1 (strain)",
-                     "pressure_shear: steady state = no drift of H and mu between the two halves "
-                     "of the last window of this strain."));
-    s.push_back(real("steady.h_tolerance", &C::steady, &C::Steady::h_tolerance, 0.0, 1.0, true, "",
-                     "Relative change of mean H allowed between the window halves."));
-    s.push_back(real("steady.mu_tolerance", &C::steady, &C::Steady::mu_tolerance, 0.0, 10.0, true,
-                     "", "Change of mean mu allowed between the window halves."));
-    s.push_back(real("steady.drift_z", &C::steady, &C::Steady::drift_z, 0.0, 100.0, true, "",
-                     "pressure_shear: the measured window is stationary when the net y drag on "
-                     "the discs, mu_top - mu_bottom and the change of H across it are each zero "
-                     "within this many standard errors (time blocks of analysis.error_block)."));
-    s.push_back(real("steady.bulk_load_tolerance", &C::steady, &C::Steady::bulk_load_tolerance, 0.0,
-                     1.0, true, "",
-                     "pressure_shear: ... and when -sigma_yy of the pair forces in the bulk is P "
-                     "within this fraction."));
-    s.push_back(real("steady.measure_strain", &C::steady, &C::Steady::measure_strain, 0.0, 1e5,
-                     false, "1 (strain)",
-                     "pressure_shear: strain simulated after steady state, then stop (0 = run to "
-                     "run.strain; run.strain always caps the run)."));
+    declare_section(s, &C::steady);
     s.push_back(real("observables.wall_exclusion", &C::observables, &C::Observables::wall_exclusion,
                      0.0, 100.0, false, "d",
                      "pressure_shear: slab next to each wall left out of the bulk phi."));
@@ -325,40 +317,7 @@ const std::vector<KeySpec>& schema() {
                         "Profiles across the gap of a scene with walls, over the measured window: "
                         "phi, u_x, T = <u'.u'> and the pair stresses sigma_xy and p per bin "
                         "(summary.json: profile_*). Off = they cost nothing."));
-    s.push_back(boolean("analysis.diffusion", &C::analysis, &C::Analysis::diffusion,
-                        "Self-diffusion analysis over the measured window (steady state, or "
-                        "after run.transient_strain): MSD, D, dv, VACF, Psi; writes "
-                        "DIR/analysis.h5. Off = it costs nothing."));
-    s.push_back(real("analysis.msd_window_lo", &C::analysis, &C::Analysis::msd_window_lo, 0.0, 1e5,
-                     false, "1 (strain)", "Start of the MSD fit window (seed: 8)."));
-    s.push_back(real("analysis.msd_window_hi", &C::analysis, &C::Analysis::msd_window_hi, 0.0, 1e5,
-                     true, "1 (strain)", "End of the MSD fit window (seed: 15)."));
-    s.push_back(integer("analysis.reference_times", &C::analysis, &C::Analysis::reference_times, 1,
-                        1e8, "",
-                        "Unused (kept so that older configs load): every sample of the measured "
-                        "window is a reference time t0 of the MSD."));
-    s.push_back(real("analysis.sample_strain", &C::analysis, &C::Analysis::sample_strain, 0.0, 1.0,
-                     false, "1 (strain)",
-                     "Strain between two samples of the diffusion analysis, taken during the run "
-                     "(independent of the trajectory); 0 = output.frame_strain / 10, i.e. ~100 "
-                     "samples per persistence time."));
-    s.push_back(real_list(
-        "analysis.velocity_intervals", &C::analysis, &C::Analysis::velocity_intervals, 0.0, 1.0,
-        true, "1 (strain)",
-        "Also report dv and Psi of the displacement velocity (y(t + Delta) - y(t)) / Delta for "
-        "each interval Delta here (rounded to the analysis's grid), beside those of the "
-        "instantaneous velocities; e.g. [0.0035, 0.01]. Each costs ~80 samples of memory."));
-    s.push_back(real("analysis.coarse_strain", &C::analysis, &C::Analysis::coarse_strain, 0.0, 1e3,
-                     false, "1 (strain)",
-                     "Strain between the samples D and its error bar are fitted to (every one "
-                     "an origin of the MSD), rounded to a whole number of samples; 0 = "
-                     "min(0.2, analysis.msd_window_hi / 75), i.e. 36 lags in the seed's window."));
-    s.push_back(real("analysis.vacf_max_lag", &C::analysis, &C::Analysis::vacf_max_lag, 0.0, 1e3,
-                     true, "1 (strain)", "Longest lag of the velocity autocorrelation."));
-    s.push_back(real("analysis.error_block", &C::analysis, &C::Analysis::error_block, 0.0, 1e5,
-                     true, "1 (strain)",
-                     "Time blocks of the error bars (phi, mu, dv, Psi, D): longer than the "
-                     "correlation time (>= 10 Psi); at least 4 blocks are used."));
+    declare_section(s, &C::analysis);
     s.push_back(real("output.frame_strain", &C::output, &C::Output::frame_strain, 0.0, 1e5, false,
                      "1 (strain)",
                      "Strain between two trajectory frames; 0 = 0.035 J^(1/4), i.e. 10 frames per "

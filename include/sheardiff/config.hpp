@@ -11,6 +11,8 @@
 #include "sheardiff/interactions/contact_params.hpp"
 #include "sheardiff/interactions/lubrication_params.hpp"
 #include "sheardiff/interactions/repulsion_params.hpp"
+#include "sheardiff/observe/diffusion_params.hpp"
+#include "sheardiff/observe/steady_state_params.hpp"
 
 namespace sheardiff {
 
@@ -79,30 +81,13 @@ struct Config {
     double steady_window = 800.0;      // a / <u>
     double steady_tolerance = 0.02;    // of the centreline distance, between window halves
   } channel;
-  struct Steady {
-    double window = 2.0;                // strain window of the no-drift test
-    double h_tolerance = 0.01;          // relative drift of H allowed between the window halves
-    double mu_tolerance = 0.05;         // drift of mu allowed between the window halves
-    double measure_strain = 0.0;        // strain run after steady state (0 = until run.strain)
-    double drift_z = 3.0;               // standard errors a window's drift signals may reach
-    double bulk_load_tolerance = 0.05;  // of P, for the bulk's -sigma_yy
-  } steady;
+  SteadyStateParams steady;  // the pressure cell's steady-state test declares its keys
   struct Observables {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi
     double profile_bin = 0.5;     // d, bin width of the profiles across the gap
     bool profiles = true;         // profiles across the gap (scenes with walls)
   } observables;
-  struct Analysis {
-    bool diffusion = true;                   // MSD, VACF, dv, Psi, D over the measured window
-    double msd_window_lo = 8.0;              // strain
-    double msd_window_hi = 15.0;             // strain
-    std::int64_t reference_times = 1000;     // unused: every sample is an origin
-    double vacf_max_lag = 2.0;               // strain
-    double error_block = 3.0;                // strain: time blocks of the error bars
-    double sample_strain = 0.0;              // strain between samples; 0 = output.frame_strain / 10
-    double coarse_strain = 0.0;              // strain between the samples D comes from; 0 = auto
-    std::vector<double> velocity_intervals;  // strain: displacement-velocity definitions
-  } analysis;
+  DiffusionParams analysis;  // the diffusion analysis declares its keys
   struct Output {
     double frame_strain = 0.0;  // 0 = resolved from J so that C(tau) gets >= 10 frames per Psi
     bool velocities = true;

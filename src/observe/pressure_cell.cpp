@@ -52,7 +52,7 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
 }
 
 StationarityVerdict pressure_cell_stationarity(
-    const Config::Steady& cfg, const std::vector<double>& strain, const std::vector<double>& h,
+    const SteadyStateParams& cfg, const std::vector<double>& strain, const std::vector<double>& h,
     const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
     const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
     double to, double block) {

@@ -119,7 +119,7 @@ TEST(Stationarity, PressureCellNamesTheDriftingSignal) {
   };
   const auto h = scaled(40.0, 0.3, 0.0), top = scaled(0.5, 0.05, 0.0);
   const auto bottom = scaled(0.5, 0.05, 0.0), load = scaled(1.0, 0.05, 0.0);
-  sd::Config::Steady cfg;
+  sd::SteadyStateParams cfg;
   const auto still = scaled(0.0, 0.05, 0.0), sinking = scaled(0.05, 0.05, 0.0);
   const auto ok =
       sd::pressure_cell_stationarity(cfg, t, h, top, bottom, still, load, kFrom, kTo, 3.0);

@@ -20,7 +20,7 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
 // each within steady.drift_z standard errors; the bulk's normal load P within
 // steady.bulk_load_tolerance. Samples as in add_steady_errors, blocks of `block` strain.
 StationarityVerdict pressure_cell_stationarity(
-    const Config::Steady& cfg, const std::vector<double>& strain, const std::vector<double>& h,
+    const SteadyStateParams& cfg, const std::vector<double>& strain, const std::vector<double>& h,
     const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
     const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
     double to, double block);
@@ -59,7 +59,7 @@ class PressureCellObserver final : public Observer {
   static double bulk_phi(const Dynamics& d, double exclusion);
 
  private:
-  Config::Steady steady_cfg_;
+  SteadyStateParams steady_cfg_;
   double exclusion_, pressure_, lz_, run_strain_, error_block_;
   std::vector<double> hist_strain_, hist_h_, hist_mu_;
   double steady_at_ = -1.0;    // strain at which steadiness was detected
