@@ -15,7 +15,9 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
    /connectivity/contacts within contact distance), while the same positions under the box
    without its tilt show the false overlaps across the y edges that the tilt removes;
 5. the LAMMPS dump export (tools/h5md_to_lammps.py) read by MDAnalysis: positions, velocities and
-   box as h5py reads them, the unwrapped positions continuous.
+   box as h5py reads them, the unwrapped positions continuous;
+6. storage: per-frame series shuffled and deflated, no unwrapped_position where it is
+   position + image . edges.
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -246,6 +248,22 @@ def check_continuity(root, traj):
                              f"(largest move per frame {gstep:.3f} d)")
 
 
+def check_storage(simple, pressure):
+    """Per-frame series compressed (shuffle + deflate), and nothing stored that the same file
+    already holds: without Lees-Edwards the unwrapped position is position + image . edges, so
+    the pressure cell stores no copy (simple shear keeps its own: its x differs, docs/trajectory.md)."""
+    for traj, lees_edwards in ((simple, True), (pressure, False)):
+        with h5py.File(traj, "r") as f:
+            g = f["particles/suspension"]
+            for name in ("position", "velocity", "image"):
+                ds = g[name]["value"]
+                expect(ds.compression == "gzip" and ds.shuffle,
+                       f"{traj.parent.name}: {name} is shuffled and deflated "
+                       f"({ds.compression}, shuffle {ds.shuffle})")
+            expect(("unwrapped_position" in g) == lees_edwards,
+                   f"{traj.parent.name}: unwrapped_position stored only under Lees-Edwards")
+
+
 def check_mdanalysis(root, traj, periodic_y):
     """MDAnalysis (Debian's python3-mdanalysis) reads the LAMMPS dump export
     (tools/h5md_to_lammps.py): every frame's positions equal h5py's (to float32, MDAnalysis's
@@ -403,6 +421,7 @@ def main():
     with h5py.File(pressure, "r") as f:
         expect("profiles" not in f["observables"],
                "pressure cell: the profiles are in summary.json, not in the trajectory")
+    check_storage(simple, pressure)
     try:
         import gsd.hoomd  # noqa: F401
     except ImportError:
