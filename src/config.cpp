@@ -272,41 +272,7 @@ const std::vector<KeySpec>& schema() {
                      "so that it settles onto the packing instead of jumping."));
     s.push_back(real("walls.jitter", &C::walls, &C::Walls::jitter, 0.0, 1.0, false, "radius",
                      "pressure_shear: random y offset of wall particle centres (roughness)."));
-    s.push_back(real("channel.phi", &C::channel, &C::Channel::phi, 0.0, 0.6, true, "",
-                     "channel: bulk areal fraction of the mobile discs over the area Lx H between "
-                     "the wall rows (the seed's phi_b)."));
-    s.push_back(real("channel.h_over_a", &C::channel, &C::Channel::h_over_a, 4.0, 400.0, false, "a",
-                     "channel: width H over the disc radius a, H between the surfaces of the "
-                     "two wall rows (the seed's shortest distance between the walls)."));
-    s.push_back(integer("channel.wall_discs", &C::channel, &C::Channel::wall_discs, 3, 1e5, "",
-                        "channel: touching discs per wall row; the periodic length is "
-                        "Lx = wall_discs d (the seed's N_w)."));
-    s.push_back(real("channel.mean_velocity", &C::channel, &C::Channel::mean_velocity, 0.0, 1e3,
-                     true, "P d / eta",
-                     "channel: mean velocity <u> of the fluid across the channel, held fixed by "
-                     "the pressure gradient (an output)."));
-    s.push_back(choice(
-        "channel.coupling", {"two_way", "one_way"},
-        "channel: two_way = the fluid's mean profile U_f(y) is solved with the particles each "
-        "step (it blunts with them; the pressure gradient is an output); one_way = a fixed "
-        "Poiseuille background that the particles do not change.",
-        [](const C& c) { return Value{c.channel.coupling}; },
-        [](C& c, const Value& v) { c.channel.coupling = std::get<std::string>(v); }));
-    s.push_back(integer("channel.fluid_cells", &C::channel, &C::Channel::fluid_cells, 0, 1e5, "",
-                        "channel: linear elements of the fluid profile across H; 0 = one per a/2 "
-                        "(the seed's profile bins), at least 4."));
-    s.push_back(real("channel.sample_interval", &C::channel, &C::Channel::sample_interval, 0.0, 1e6,
-                     true, "a / <u>",
-                     "channel: time between two rows of the profile history (profiles averaged "
-                     "over each interval, pressure gradient, centreline distance)."));
-    s.push_back(real("channel.steady_window", &C::channel, &C::Channel::steady_window, 0.0, 1e7,
-                     true, "a / <u>",
-                     "channel: migration is steady when the mean distance of the discs from the "
-                     "centreline drifts less than channel.steady_tolerance between the two "
-                     "halves of the last window of this length."));
-    s.push_back(real("channel.steady_tolerance", &C::channel, &C::Channel::steady_tolerance, 0.0,
-                     1.0, true, "",
-                     "channel: relative drift allowed (see channel.steady_window)."));
+    declare_section(s, &C::channel);
     declare_section(s, &C::steady);
     s.push_back(real("observables.wall_exclusion", &C::observables, &C::Observables::wall_exclusion,
                      0.0, 100.0, false, "d",
@@ -511,29 +477,9 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
 }
 
 void check_combinations(const Config& c, const std::string& origin) {
-  if (scene_kind(c.scene.type).channel_flow) {
-    if (c.particles.size_ratio != 1.0)
-      fail(origin, "particles.size_ratio",
-           fmt::format("{:g}: the channel scene is monodisperse (the seed's spheres); set 1",
-                       c.particles.size_ratio));
-    if (c.analysis.diffusion)
-      fail(origin, "analysis.diffusion",
-           "the channel has no imposed shear rate to scale the diffusion analysis by; set "
-           "false (the channel's own profiles and time series are always written)");
-    if (c.channel.fluid_cells != 0 && c.channel.fluid_cells < 4)
-      fail(origin, "channel.fluid_cells",
-           fmt::format("{}: at least 4 elements across the channel", c.channel.fluid_cells));
-    if (!c.particles.init_file.empty())
-      fail(origin, "particles.init_file",
-           "the channel scene places its discs itself (the seed's lattice and Monte Carlo "
-           "start); leave it empty");
-    const double interior = c.channel.phi * static_cast<double>(c.channel.wall_discs) * 2.0 *
-                            c.channel.h_over_a / std::numbers::pi;
-    if (std::llround(interior) < 1)
-      fail(origin, "channel.phi",
-           fmt::format("{:g} puts no disc in a channel of {} wall discs and H/a = {:g}",
-                       c.channel.phi, c.channel.wall_discs, c.channel.h_over_a));
-  }
+  if (const auto check = scene_kind(c.scene.type).check)
+    if (const std::optional<ConfigProblem> problem = check(c))
+      fail(origin, problem->key, problem->message);
   if (c.analysis.msd_window_lo >= c.analysis.msd_window_hi)
     fail(origin, "analysis.msd_window_lo",
          fmt::format("{:g} must be below analysis.msd_window_hi = {:g}", c.analysis.msd_window_lo,
@@ -586,8 +532,8 @@ double overlap_change_limit(const Config& c) {
 
 void resolve_defaults(Config& c) {
   if (c.output.frame_strain <= 0.0)
-    c.output.frame_strain = scene_kind(c.scene.type).channel_flow
-                                ? std::min(c.channel.sample_interval, c.run.strain)
+    c.output.frame_strain = scene_kind(c.scene.type).default_frame_spacing
+                                ? scene_kind(c.scene.type).default_frame_spacing(c)
                                 : 0.035 * std::pow(c.flow.j, 0.25);
   if (c.analysis.sample_strain <= 0.0) c.analysis.sample_strain = 0.1 * c.output.frame_strain;
   if (c.analysis.coarse_strain <= 0.0)

@@ -51,9 +51,9 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
     } catch (const std::exception& e) {
       throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
     }
-  } else if (scene_kind(cfg.scene.type).channel_flow) {
-    lx = static_cast<double>(cfg.channel.wall_discs);
-    ly = cfg.channel.h_over_a * 0.5;
+  } else if (const auto planned = scene_kind(cfg.scene.type).planned_cell) {
+    const PlannedCell cell = planned(cfg);
+    lx = cell.lx, ly = cell.ly;
   } else {
     // The cell random_packing makes, without placing anything.
     double area = 0.0;

@@ -10,10 +10,8 @@
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
-#include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/run_extension.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/version.hpp"
@@ -287,7 +285,7 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
   js["finished"] = iso8601_utc_now();
   js["scene"] = cfg.scene.type;
   js["N"] = static_cast<std::int64_t>(p.n_mobile);
-  if (!scene_kind(cfg.scene.type).channel_flow) js["J"] = cfg.flow.j;
+  if (scene_kind(cfg.scene.type).imposes_shear_rate) js["J"] = cfg.flow.j;
   js["ktilde"] = cfg.contact.ktilde;
   js["integrator"] = to_string(cfg.integrator.type);
   js["strain"] = d.strain();
@@ -332,30 +330,8 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
 }
 
 // Only the observers the scene and the config ask for are composed into the run.
-std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
-                                                      const std::filesystem::path& out_dir) {
-  std::vector<std::unique_ptr<Observer>> obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  MeasuredWindow measuring;
-  // A scene measured from its steady state has the pressure cell's detector of it.
-  if (scene_kind(cfg.scene.type).measured_from_steady_state) {
-    auto cell = std::make_unique<PressureCellObserver>(cfg);
-    const PressureCellObserver* c = cell.get();
-    measuring = [c](const Dynamics&) { return c->steady(); };
-    obs.push_back(std::move(cell));
-  } else {
-    const double from = cfg.run.transient_strain;
-    measuring = [from](const Dynamics& d) { return d.strain() > from; };
-  }
-  if (scene_kind(cfg.scene.type).channel_flow) {
-    obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
-    return obs;
-  }
-  if (cfg.observables.profiles && !scene_kind(cfg.scene.type).periodic_y)
-    obs.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
-  if (cfg.analysis.diffusion)
-    obs.push_back(std::make_unique<DiffusionObserver>(cfg, out_dir / kAnalysisFile, measuring));
-  return obs;
+ObserverList make_observers(const Config& cfg, const std::filesystem::path& out_dir) {
+  return scene_kind(cfg.scene.type).observers(cfg, out_dir);
 }
 
 }  // namespace sheardiff

@@ -13,6 +13,7 @@
 #include "sheardiff/interactions/repulsion_params.hpp"
 #include "sheardiff/observe/diffusion_params.hpp"
 #include "sheardiff/observe/steady_state_params.hpp"
+#include "sheardiff/scene/channel_params.hpp"
 
 namespace sheardiff {
 
@@ -70,17 +71,7 @@ struct Config {
     double free_fall_speed = 0.5;  // |V| cap while nothing holds the top wall
     double jitter = 0.4;           // y disorder of wall particle centres, in radii
   } walls;
-  struct Channel {
-    double phi = 0.4;                  // bulk areal fraction
-    double h_over_a = 18.32;           // H / a, between the wall rows' surfaces
-    std::int64_t wall_discs = 9;       // discs per wall row; Lx = wall_discs d
-    double mean_velocity = 1.0;        // <u>, P d / eta
-    std::string coupling = "two_way";  // or "one_way" (a fixed Poiseuille background)
-    std::int64_t fluid_cells = 0;      // elements across H; 0 = one per a/2
-    double sample_interval = 20.0;     // a / <u>
-    double steady_window = 800.0;      // a / <u>
-    double steady_tolerance = 0.02;    // of the centreline distance, between window halves
-  } channel;
+  ChannelParams channel;     // the channel scene declares its keys
   SteadyStateParams steady;  // the pressure cell's steady-state test declares its keys
   struct Observables {
     double wall_exclusion = 3.0;  // d excluded next to each wall for the bulk phi

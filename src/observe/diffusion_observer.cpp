@@ -272,7 +272,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
           o));
   const Config cfg = load_config(dir / "config.toml", overrides);
   const nlohmann::json run = read_summary(dir);
-  if (scene_kind(cfg.scene.type).channel_flow)
+  if (!scene_kind(cfg.scene.type).imposes_shear_rate)
     throw ConfigError(fmt::format(
         "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
         "and summary.json, read by tools/channel_table.py",

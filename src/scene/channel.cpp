@@ -1,6 +1,8 @@
 // Pressure-driven channel flow (Nott & Brady 1994): monodisperse discs between two fixed,
 // straight rows of touching wall discs, periodic in x, pumped at a fixed mean velocity <u>.
 // Geometry and fluid in docs/channel.md.
+#include "sheardiff/observe/channel.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <numbers>
 #include <random>
 
+#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/scene/scene.hpp"
 
 namespace sheardiff {
@@ -120,6 +123,52 @@ Scene build_channel(const Config& cfg) {
                      0.5 * cfg.neighbour.skin);
   }
   return sc;
+}
+
+std::optional<ConfigProblem> check_channel(const Config& c) {
+  const ChannelParams& ch = c.channel;
+  if (c.particles.size_ratio != 1.0)
+    return ConfigProblem{
+        "particles.size_ratio",
+        fmt::format("{:g}: the channel scene is monodisperse (the seed's spheres); set 1",
+                    c.particles.size_ratio)};
+  if (c.analysis.diffusion)
+    return ConfigProblem{"analysis.diffusion",
+                         "the channel has no imposed shear rate to scale the diffusion analysis "
+                         "by; set false (the channel's own profiles and time series are always "
+                         "written)"};
+  if (ch.fluid_cells != 0 && ch.fluid_cells < 4)
+    return ConfigProblem{"channel.fluid_cells",
+                         fmt::format("{}: at least 4 elements across the channel", ch.fluid_cells)};
+  if (!c.particles.init_file.empty())
+    return ConfigProblem{"particles.init_file",
+                         "the channel scene places its discs itself (the seed's lattice and "
+                         "Monte Carlo start); leave it empty"};
+  const double interior =
+      ch.phi * static_cast<double>(ch.wall_discs) * 2.0 * ch.h_over_a / std::numbers::pi;
+  if (std::llround(interior) < 1)
+    return ConfigProblem{
+        "channel.phi", fmt::format("{:g} puts no disc in a channel of {} wall discs and H/a = {:g}",
+                                   ch.phi, ch.wall_discs, ch.h_over_a)};
+  return std::nullopt;
+}
+
+// One frame per row of the profile history, in a / <u>.
+double channel_frame_spacing(const Config& c) {
+  return std::min(c.channel.sample_interval, c.run.strain);
+}
+
+// Lx = wall_discs d; H = h_over_a a between the wall rows' surfaces.
+PlannedCell channel_cell(const Config& c) {
+  return {static_cast<double>(c.channel.wall_discs), 0.5 * c.channel.h_over_a};
+}
+
+// No shear analyses: the channel's observer writes its profiles and time series.
+ObserverList channel_observers(const Config& cfg, const std::filesystem::path& out_dir) {
+  ObserverList obs;
+  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
+  obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
+  return obs;
 }
 
 }  // namespace sheardiff

@@ -1,42 +1,61 @@
-// The scene registry: one row per scene. A new scene is its builder in src/scene/NAME.cpp plus
-// one row here (and its declaration below).
+// The scene registry: one row per scene. A new scene is its file src/scene/NAME.cpp (the
+// builder and the scene's answers) plus one row here (and the declarations above it).
 //
 // The config parser's fuzz target (tests/fuzz) compiles this file alone for the scene names, with
-// SHEARDIFF_SCENE_NAMES_ONLY: then no builder is linked.
+// SHEARDIFF_SCENE_NAMES_ONLY: then none of the scenes' functions is linked.
 #include "sheardiff/scene/registry.hpp"
 
 #include <fmt/format.h>
 
 #ifndef SHEARDIFF_SCENE_NAMES_ONLY
 #include "sheardiff/scene/scene.hpp"
-#define SHEARDIFF_SCENE_BUILDER(f) f
+#define SHEARDIFF_SCENE(f) f
 #else
-#define SHEARDIFF_SCENE_BUILDER(f) nullptr
+#define SHEARDIFF_SCENE(f) nullptr
 #endif
 
 namespace sheardiff {
 
-// Builders, one file each in src/scene.
+// Each scene's functions, one file each in src/scene.
 Scene build_simple_shear(const Config& cfg);
+std::vector<std::unique_ptr<Observer>> simple_shear_observers(const Config&,
+                                                              const std::filesystem::path&);
 Scene build_pressure_shear(const Config& cfg);
+std::vector<std::unique_ptr<Observer>> pressure_shear_observers(const Config&,
+                                                                const std::filesystem::path&);
 Scene build_channel(const Config& cfg);
+std::optional<ConfigProblem> check_channel(const Config& cfg);
+double channel_frame_spacing(const Config& cfg);
+PlannedCell channel_cell(const Config& cfg);
+std::vector<std::unique_ptr<Observer>> channel_observers(const Config&,
+                                                         const std::filesystem::path&);
 
 const std::vector<SceneKind>& scene_registry() {
   static const std::vector<SceneKind> rows = {
-      {"simple_shear",
-       "`simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate",
-       SHEARDIFF_SCENE_BUILDER(build_simple_shear), /*periodic_y=*/true,
-       /*measured_from_steady_state=*/false},
-      {"pressure_shear",
-       "`pressure_shear` = plane shear between rough walls, the top wall floating under the load "
-       "P Lx lz (the packing dilates to phi(J))",
-       SHEARDIFF_SCENE_BUILDER(build_pressure_shear), /*periodic_y=*/false,
-       /*measured_from_steady_state=*/true},
-      {"channel",
-       "`channel` = pressure-driven flow of monodisperse discs between two fixed rows of wall "
-       "discs at a fixed mean velocity <u> (migration; the second seed paper)",
-       SHEARDIFF_SCENE_BUILDER(build_channel), /*periodic_y=*/false,
-       /*measured_from_steady_state=*/false, /*channel_flow=*/true},
+      {.name = "simple_shear",
+       .doc = "`simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate",
+       .build = SHEARDIFF_SCENE(build_simple_shear),
+       .periodic_y = true,
+       .measured_from_steady_state = false,
+       .observers = SHEARDIFF_SCENE(simple_shear_observers)},
+      {.name = "pressure_shear",
+       .doc = "`pressure_shear` = plane shear between rough walls, the top wall floating under "
+              "the load P Lx lz (the packing dilates to phi(J))",
+       .build = SHEARDIFF_SCENE(build_pressure_shear),
+       .periodic_y = false,
+       .measured_from_steady_state = true,
+       .observers = SHEARDIFF_SCENE(pressure_shear_observers)},
+      {.name = "channel",
+       .doc = "`channel` = pressure-driven flow of monodisperse discs between two fixed rows of "
+              "wall discs at a fixed mean velocity <u> (migration; the second seed paper)",
+       .build = SHEARDIFF_SCENE(build_channel),
+       .periodic_y = false,
+       .measured_from_steady_state = false,
+       .imposes_shear_rate = false,
+       .check = SHEARDIFF_SCENE(check_channel),
+       .default_frame_spacing = SHEARDIFF_SCENE(channel_frame_spacing),
+       .planned_cell = SHEARDIFF_SCENE(channel_cell),
+       .observers = SHEARDIFF_SCENE(channel_observers)},
   };
   return rows;
 }

@@ -28,13 +28,14 @@ TEST(SceneRegistry, EveryRowBuildsItsSceneAndIsAValidSceneType) {
     EXPECT_EQ(sc.walls.has_value(), !k.periodic_y) << k.name;
     EXPECT_EQ(sc.box.lees_edwards, k.periodic_y) << k.name;
     // The channel's disc count follows from its areal fraction, width and wall row.
-    const Config::Channel ch;
-    const auto n = k.channel_flow ? static_cast<std::size_t>(std::llround(
-                                        ch.phi * 2.0 * ch.wall_discs * ch.h_over_a / kPi))
-                                  : 60u;
+    const ChannelParams ch;
+    const auto n = !k.imposes_shear_rate ? static_cast<std::size_t>(std::llround(
+                                               ch.phi * 2.0 * ch.wall_discs * ch.h_over_a / kPi))
+                                         : 60u;
     EXPECT_EQ(sc.particles.n_mobile, n) << k.name;
-    const std::string needs =
-        k.channel_flow ? "[particles]\nsize_ratio = 1.0\n[analysis]\ndiffusion = false\n" : "";
+    const std::string needs = !k.imposes_shear_rate
+                                  ? "[particles]\nsize_ratio = 1.0\n[analysis]\ndiffusion = false\n"
+                                  : "";
     const Config c =
         parse_config("[scene]\ntype = \"" + std::string(k.name) + "\"\n" + needs, "t.toml");
     EXPECT_EQ(c.scene.type, k.name);

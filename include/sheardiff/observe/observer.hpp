@@ -1,6 +1,7 @@
 #pragma once
 #include <functional>
 #include <limits>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -53,6 +54,9 @@ class Observer {
     (void)writer;
   }
 };
+
+// A run's observers, in their update order.
+using ObserverList = std::vector<std::unique_ptr<Observer>>;
 
 // Stress and contact statistics of any scene, time-averaged after run.transient_strain.
 class RheologyObserver final : public Observer {
