@@ -10,8 +10,10 @@
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/text.hpp"
+#include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/observe/shear_analyses.hpp"
 #include "sheardiff/run_extension.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/version.hpp"
@@ -285,7 +287,7 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
   js["finished"] = iso8601_utc_now();
   js["scene"] = cfg.scene.type;
   js["N"] = static_cast<std::int64_t>(p.n_mobile);
-  if (scene_kind(cfg.scene.type).imposes_shear_rate) js["J"] = cfg.flow.j;
+  if (scene_kind(cfg.scene.type).imposes_shear_rate()) js["J"] = cfg.flow.j;
   js["ktilde"] = cfg.contact.ktilde;
   js["integrator"] = to_string(cfg.integrator.type);
   js["strain"] = d.strain();
@@ -331,7 +333,34 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
 
 // Only the observers the scene and the config ask for are composed into the run.
 ObserverList make_observers(const Config& cfg, const std::filesystem::path& out_dir) {
-  return scene_kind(cfg.scene.type).observers(cfg, out_dir);
+  return make_observers(scene_kind(cfg.scene.type), cfg, out_dir);
+}
+
+ObserverList make_observers(const SceneKind& scene, const Config& cfg,
+                            const std::filesystem::path& out_dir) {
+  ObserverList obs;
+  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
+  switch (scene.measures) {
+    case Measures::ShearAfterTransient: {
+      const double from = cfg.run.transient_strain;
+      add_shear_analyses(
+          obs, cfg, out_dir, [from](const Dynamics& d) { return d.strain() > from; },
+          !scene.periodic_y);
+      break;
+    }
+    case Measures::ShearFromSteadyState: {
+      auto cell = std::make_unique<PressureCellObserver>(cfg);
+      const PressureCellObserver* c = cell.get();
+      obs.push_back(std::move(cell));
+      add_shear_analyses(
+          obs, cfg, out_dir, [c](const Dynamics&) { return c->steady(); }, !scene.periodic_y);
+      break;
+    }
+    case Measures::ChannelMigration:
+      obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
+      break;
+  }
+  return obs;
 }
 
 }  // namespace sheardiff

@@ -16,6 +16,7 @@
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
+#include "sheardiff/scene/registry.hpp"
 
 namespace sheardiff {
 
@@ -110,8 +111,10 @@ class RunProgress {
 nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
                            RunDirectory& dir, TrajectoryOutput& trajectory);
 
-// The observers the scene and the config ask for (and only those), in their update order.
-std::vector<std::unique_ptr<Observer>> make_observers(const Config& cfg,
-                                                      const std::filesystem::path& out_dir);
+// The observers the scene and the config ask for (and only those), in their update order: what
+// the scene measures (SceneKind::measures) decides which.
+ObserverList make_observers(const Config& cfg, const std::filesystem::path& out_dir);
+ObserverList make_observers(const SceneKind& scene, const Config& cfg,
+                            const std::filesystem::path& out_dir);
 
 }  // namespace sheardiff

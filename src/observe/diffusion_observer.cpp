@@ -272,14 +272,14 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
           o));
   const Config cfg = load_config(dir / "config.toml", overrides);
   const nlohmann::json run = read_summary(dir);
-  if (!scene_kind(cfg.scene.type).imposes_shear_rate)
+  if (!scene_kind(cfg.scene.type).imposes_shear_rate())
     throw ConfigError(fmt::format(
         "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
         "and summary.json, read by tools/channel_table.py",
         dir.string()));
   // The measured window: frames from the detection of steady state (pressure cell) or after
   // the transient (simple shear), the same test the observers applied while running.
-  const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state;
+  const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state();
   if (pressure && !run.value("steady", false))
     throw std::runtime_error(fmt::format("{}: the run never reached steady state", dir.string()));
   const double from = pressure ? run["steady_detected_at"].get<double>() : cfg.run.transient_strain;

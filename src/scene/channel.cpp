@@ -163,12 +163,4 @@ PlannedCell channel_cell(const Config& c) {
   return {static_cast<double>(c.channel.wall_discs), 0.5 * c.channel.h_over_a};
 }
 
-// No shear analyses: the channel's observer writes its profiles and time series.
-ObserverList channel_observers(const Config& cfg, const std::filesystem::path& out_dir) {
-  ObserverList obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
-  return obs;
-}
-
 }  // namespace sheardiff

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <random>
 
-#include "sheardiff/observe/pressure_cell.hpp"
-#include "sheardiff/observe/shear_analyses.hpp"
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
@@ -101,19 +99,6 @@ Scene build_pressure_shear(const Config& cfg) {
   sc.flow.y0 = y_bottom;
   sc.walls = std::move(walls);
   return sc;
-}
-
-// Measured from the steady state the cell's own test detects (the packing dilates or compacts
-// to phi(J) first).
-ObserverList pressure_shear_observers(const Config& cfg, const std::filesystem::path& out_dir) {
-  ObserverList obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  auto cell = std::make_unique<PressureCellObserver>(cfg);
-  const PressureCellObserver* c = cell.get();
-  obs.push_back(std::move(cell));
-  add_shear_analyses(
-      obs, cfg, out_dir, [c](const Dynamics&) { return c->steady(); }, /*between_walls=*/true);
-  return obs;
 }
 
 }  // namespace sheardiff

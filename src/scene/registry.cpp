@@ -18,17 +18,11 @@ namespace sheardiff {
 
 // Each scene's functions, one file each in src/scene.
 Scene build_simple_shear(const Config& cfg);
-std::vector<std::unique_ptr<Observer>> simple_shear_observers(const Config&,
-                                                              const std::filesystem::path&);
 Scene build_pressure_shear(const Config& cfg);
-std::vector<std::unique_ptr<Observer>> pressure_shear_observers(const Config&,
-                                                                const std::filesystem::path&);
 Scene build_channel(const Config& cfg);
 std::optional<ConfigProblem> check_channel(const Config& cfg);
 double channel_frame_spacing(const Config& cfg);
 PlannedCell channel_cell(const Config& cfg);
-std::vector<std::unique_ptr<Observer>> channel_observers(const Config&,
-                                                         const std::filesystem::path&);
 
 const std::vector<SceneKind>& scene_registry() {
   static const std::vector<SceneKind> rows = {
@@ -36,26 +30,22 @@ const std::vector<SceneKind>& scene_registry() {
        .doc = "`simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate",
        .build = SHEARDIFF_SCENE(build_simple_shear),
        .periodic_y = true,
-       .measured_from_steady_state = false,
-       .observers = SHEARDIFF_SCENE(simple_shear_observers)},
+       .measures = Measures::ShearAfterTransient},
       {.name = "pressure_shear",
        .doc = "`pressure_shear` = plane shear between rough walls, the top wall floating under "
               "the load P Lx lz (the packing dilates to phi(J))",
        .build = SHEARDIFF_SCENE(build_pressure_shear),
        .periodic_y = false,
-       .measured_from_steady_state = true,
-       .observers = SHEARDIFF_SCENE(pressure_shear_observers)},
+       .measures = Measures::ShearFromSteadyState},
       {.name = "channel",
        .doc = "`channel` = pressure-driven flow of monodisperse discs between two fixed rows of "
               "wall discs at a fixed mean velocity <u> (migration; the second seed paper)",
        .build = SHEARDIFF_SCENE(build_channel),
        .periodic_y = false,
-       .measured_from_steady_state = false,
-       .imposes_shear_rate = false,
+       .measures = Measures::ChannelMigration,
        .check = SHEARDIFF_SCENE(check_channel),
        .default_frame_spacing = SHEARDIFF_SCENE(channel_frame_spacing),
-       .planned_cell = SHEARDIFF_SCENE(channel_cell),
-       .observers = SHEARDIFF_SCENE(channel_observers)},
+       .planned_cell = SHEARDIFF_SCENE(channel_cell)},
   };
   return rows;
 }

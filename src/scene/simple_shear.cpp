@@ -1,6 +1,5 @@
 // Simple shear (Lees-Edwards periodic cell at fixed area fraction and shear rate): the engine's
 // validation scene.
-#include "sheardiff/observe/shear_analyses.hpp"
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
@@ -22,17 +21,6 @@ Scene build_simple_shear(const Config& cfg) {
   sc.flow.gammadot = cfg.flow.j;
   sc.flow.y0 = 0.0;
   return sc;
-}
-
-// Measured after run.transient_strain: a fixed-fraction cell has no slow dilation to wait for.
-ObserverList simple_shear_observers(const Config& cfg, const std::filesystem::path& out_dir) {
-  ObserverList obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  const double from = cfg.run.transient_strain;
-  add_shear_analyses(
-      obs, cfg, out_dir, [from](const Dynamics& d) { return d.strain() > from; },
-      /*between_walls=*/false);
-  return obs;
 }
 
 }  // namespace sheardiff

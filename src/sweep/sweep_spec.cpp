@@ -313,7 +313,7 @@ std::vector<SweepPoint> expand_points(const SweepSpec& spec) {
       continue;  // load_sweep reports it, with the point's name
     }
     const double strain =
-        scene_kind(cfg.scene.type).measured_from_steady_state && cfg.steady.measure_strain > 0
+        scene_kind(cfg.scene.type).measured_from_steady_state() && cfg.steady.measure_strain > 0
             ? cfg.steady.measure_strain + 3.0 * cfg.steady.window
             : cfg.run.strain;
     p.cost = static_cast<double>(cfg.particles.n) * std::max(strain, 1e-3) /

@@ -9,6 +9,7 @@
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/engine.hpp"
 #include "sheardiff/observe/observer.hpp"
+#include "sheardiff/run_parts.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/scene/scene.hpp"
 
@@ -112,21 +113,14 @@ Scene build_streamline_pair(const Config& cfg) {
   return sc;
 }
 
-// Its observers: the rheology every scene reports, and the mean spin above from strain 0.05.
-ObserverList streamline_pair_observers(const Config& cfg, const std::filesystem::path&) {
-  ObserverList obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
-  obs.push_back(std::make_unique<MeanSpinObserver>(0.05));
-  return obs;
-}
-
-// The row src/scene/registry.cpp would list (one line there registers the name).
+// The row src/scene/registry.cpp would list (one line there registers the name): a sheared
+// scene measured after run.transient_strain, so a run composes the rheology and the shear
+// analyses for it.
 const SceneKind kStreamlinePair{.name = "streamline_pair",
                                 .doc = "`streamline_pair` = two distant discs on one streamline",
                                 .build = build_streamline_pair,
                                 .periodic_y = true,
-                                .measured_from_steady_state = false,
-                                .observers = streamline_pair_observers};
+                                .measures = Measures::ShearAfterTransient};
 
 TEST(ExtendingExample, ASceneWrittenOutsideTheLibrary) {
   // Not registered, so scene.type does not name it ...
@@ -134,8 +128,10 @@ TEST(ExtendingExample, ASceneWrittenOutsideTheLibrary) {
   // ... but the engine and the observers take it from its row as a run takes a registered one.
   Config cfg = dilute_shear();
   Simulation sim(cfg, kStreamlinePair.build(cfg));
-  ObserverList observers = kStreamlinePair.observers(cfg, {});
-  ASSERT_EQ(observers.size(), 2u);
+  cfg.analysis.diffusion = false;  // two discs: nothing to average a diffusion over
+  ObserverList observers = make_observers(kStreamlinePair, cfg, {});
+  ASSERT_EQ(observers.size(), 1u);  // rheology; periodic in y, so no profiles across a gap
+  observers.push_back(std::make_unique<MeanSpinObserver>(0.05));
   for (int k = 0; k < 200; ++k) {
     ASSERT_TRUE(sim.try_step());
     const StressSample s = sim.sample();

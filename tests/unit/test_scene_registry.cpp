@@ -29,11 +29,11 @@ TEST(SceneRegistry, EveryRowBuildsItsSceneAndIsAValidSceneType) {
     EXPECT_EQ(sc.box.lees_edwards, k.periodic_y) << k.name;
     // The channel's disc count follows from its areal fraction, width and wall row.
     const ChannelParams ch;
-    const auto n = !k.imposes_shear_rate ? static_cast<std::size_t>(std::llround(
+    const auto n = !k.imposes_shear_rate() ? static_cast<std::size_t>(std::llround(
                                                ch.phi * 2.0 * ch.wall_discs * ch.h_over_a / kPi))
                                          : 60u;
     EXPECT_EQ(sc.particles.n_mobile, n) << k.name;
-    const std::string needs = !k.imposes_shear_rate
+    const std::string needs = !k.imposes_shear_rate()
                                   ? "[particles]\nsize_ratio = 1.0\n[analysis]\ndiffusion = false\n"
                                   : "";
     const Config c =

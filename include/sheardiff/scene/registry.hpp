@@ -2,12 +2,10 @@
 // The scene registry (src/scene/registry.cpp): one row per scene. Light on purpose (no Eigen):
 // the configuration schema reads the scene names and docs from it.
 //
-// A scene answers the engine's questions through its row: its geometry, where its measured
-// window starts, whether it imposes a shear rate, its own configuration checks, its default
-// frame spacing and cell, and the observers that measure it. Nothing outside a scene's file
-// and this registry compares scene names or branches on which scene runs.
-#include <filesystem>
-#include <memory>
+// A scene answers the run's questions through its row: its geometry, what it measures (and so
+// where its measured window starts and whether it imposes a shear rate), its own configuration
+// checks, its default frame spacing and cell. Nothing outside a scene's file and this registry
+// compares scene names.
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,7 +15,6 @@
 namespace sheardiff {
 
 struct Scene;
-class Observer;
 
 // A problem a scene finds in a configuration: the key, and what is wrong with it and what is
 // allowed (the parser adds where the configuration came from).
@@ -32,20 +29,27 @@ struct PlannedCell {
   double lx = 0.0, ly = 0.0;
 };
 
-// One row of the registry: a scene is its file in src/scene (the builder and the functions
-// below) plus this row.
+// What a scene measures; the run composes the observers for it (run_parts.cpp, make_observers).
+enum class Measures {
+  // Rheology and the shear analyses (profiles between walls, diffusion) after
+  // run.transient_strain.
+  ShearAfterTransient,
+  // The same from the steady state the pressure cell's test detects (the run may stop
+  // steady.measure_strain after it).
+  ShearFromSteadyState,
+  // The channel's migration: its profiles and time series, in the clock <u> t / a.
+  ChannelMigration,
+};
+
+// One row of the registry: a scene is its file in src/scene (the builder and the optional
+// functions below) plus this row.
 struct SceneKind {
   const char* name;  // the value of scene.type
   const char* doc;   // its line in the configuration reference
   Scene (*build)(const Config& cfg);
   // The cell is periodic in y (Lees-Edwards) rather than bounded by walls.
   bool periodic_y;
-  // The measured window starts at a detected steady state (and the run may stop
-  // steady.measure_strain after it) rather than after run.transient_strain.
-  bool measured_from_steady_state;
-  // The flow imposes a shear rate J: the clock is the strain gammadot t, J is reported, and the
-  // diffusion analysis is scaled by it. (The channel's clock is <u> t / a.)
-  bool imposes_shear_rate = true;
+  Measures measures;
   // The scene's own checks of a configuration, after every key is within its range: the first
   // problem, or none. Null: no checks of its own.
   std::optional<ConfigProblem> (*check)(const Config& cfg) = nullptr;
@@ -55,9 +59,12 @@ struct SceneKind {
   // The cell, when the scene fixes it from its own keys. Null: the cell particles.N discs make
   // at particles.phi_init and particles.aspect (or particles.init_file's).
   PlannedCell (*planned_cell)(const Config& cfg) = nullptr;
-  // The observers that measure the scene, in their update order (only those cfg asks for).
-  std::vector<std::unique_ptr<Observer>> (*observers)(const Config& cfg,
-                                                      const std::filesystem::path& out_dir);
+
+  // The measured window starts at a detected steady state, not after run.transient_strain.
+  bool measured_from_steady_state() const { return measures == Measures::ShearFromSteadyState; }
+  // The flow imposes a shear rate J: the clock is the strain gammadot t, J is reported, and the
+  // diffusion analysis is scaled by it.
+  bool imposes_shear_rate() const { return measures != Measures::ChannelMigration; }
 };
 
 // Every scene, in the order of the configuration reference.
