@@ -1,7 +1,6 @@
 // Pressure-driven channel flow (Nott & Brady 1994): monodisperse discs between two fixed,
 // straight rows of touching wall discs, periodic in x, pumped at a fixed mean velocity <u>.
 // Geometry and fluid in docs/channel.md.
-#include "sheardiff/observe/channel.hpp"
 
 #include <fmt/format.h>
 
@@ -10,7 +9,6 @@
 #include <numbers>
 #include <random>
 
-#include "sheardiff/io/run_files.hpp"
 #include "sheardiff/scene/scene.hpp"
 
 namespace sheardiff {
