@@ -1,7 +1,6 @@
 // Pressure-driven channel flow (Nott & Brady 1994): monodisperse discs between two fixed,
 // straight rows of touching wall discs, periodic in x, pumped at a fixed mean velocity <u>.
 // Geometry and fluid in docs/channel.md.
-
 #include <fmt/format.h>
 
 #include <algorithm>
