@@ -1,13 +1,15 @@
 // The worked examples of docs/extending.md, written outside the library against its interfaces
 // alone: "An analyser" (an observer, driven by the engine's steps as the run's step loop drives
 // the observers, checked against a closed form and through a checkpoint round trip) and
-// "A scene" (a builder and the registry row that answers the run's questions).
+// "A scene" (a builder and the registry row that answers the run's questions) and "A pair law"
+// (a law and its parameters, in the generic law set the pair loop is instantiated for).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/engine.hpp"
+#include "sheardiff/interactions/pair_laws.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/run_parts.hpp"
 #include "sheardiff/scene/registry.hpp"
@@ -152,6 +154,96 @@ TEST(ExtendingExample, ASceneWrittenOutsideTheLibrary) {
   for (auto& o : observers) o->finish(sim.dynamics(), js, nullptr);
   EXPECT_NEAR(js["mean_spin"].get<double>(), -0.5 * gammadot, 1e-9 * gammadot);
   EXPECT_TRUE(js.contains("shear_stress"));
+}
+
+// ---- A pair law -------------------------------------------------------------------------------
+
+// A soft corona of thickness w around each disc: a central spring F = k (s + w - r) while the
+// coronas overlap (s = a_i + a_j). Its parameters and keys, declared once (NAME_params.hpp) ...
+struct CoronaParams {
+  double k = 0.0;       // P d; 0 = off
+  double width = 0.05;  // d
+
+  template <class Keys>
+  static void declare(Keys& keys) {
+    keys.real("corona.k", &CoronaParams::k, 0.0, 1e6, false, "P d",
+              "Stiffness of the coronas' central spring; 0 = off.");
+    keys.real("corona.width", &CoronaParams::width, 0.0, 0.5, true, "d",
+              "Thickness of each disc's corona.");
+  }
+};
+
+// ... and the law (NAME.hpp): the contract of interactions/pair_law.hpp.
+struct Corona {
+  using History = NoHistory;
+  double k = 0.0, width = 0.05;
+
+  static std::optional<Corona> from(const CoronaParams& p) {
+    if (!(p.k > 0.0)) return std::nullopt;
+    return Corona{p.k, p.width};
+  }
+  double range_factor() const { return 1.0 + width; }  // the smallest pair has s = d
+  bool acts(const PairGeometry& g, bool) const { return g.r < g.s + width; }
+  void add_block(const PairGeometry& g, const History&, bool, double dt_implicit,
+                 PairBlock& b) const {
+    const Vec6 m = normal_mode(g);
+    b.add_force(-k * (g.s + width - g.r) * m);
+    // Over a step the centres approach by dt m.U: the force grows by k dt m.U.
+    if (dt_implicit > 0.0) b.add_matrix(dt_implicit * k * m * m.transpose());
+  }
+  bool resistive() const { return false; }
+  bool keeps_history() const { return false; }
+  void advance(History&, const PairGeometry&, const Vec6&, double) const {}
+  void cap(History&, const PairGeometry&) const {}
+  void add_stability(double, StabilityTerms& t) const { t.normal_stiffness += k; }
+  bool needs_rotations() const { return false; }
+};
+
+// What the schema's section adapter (src/config.cpp) reads from declare: here only recorded.
+struct RecordedKeys {
+  std::vector<std::string> names;
+  std::vector<std::pair<double, double>> ranges;
+  void real(std::string key, double CoronaParams::*, double lo, double hi, bool, std::string,
+            std::string) {
+    names.push_back(std::move(key));
+    ranges.emplace_back(lo, hi);
+  }
+};
+
+TEST(ExtendingExample, APairLawWrittenOutsideTheLibrary) {
+  RecordedKeys keys;
+  CoronaParams::declare(keys);
+  EXPECT_EQ(keys.names, (std::vector<std::string>{"corona.k", "corona.width"}));
+  EXPECT_FALSE(Corona::from(CoronaParams{}).has_value()) << "off by default: nothing computed";
+
+  // The engine's laws with the corona added, as `using PairLaws = PairLawSet<...>` would list it;
+  // lubrication and contacts off, so every number below is the corona's.
+  const CoronaParams p{.k = 100.0, .width = 0.05};
+  const PairLawSet<Lubrication, FrictionalContact, Corona> laws(std::nullopt, std::nullopt,
+                                                                Corona::from(p));
+  EXPECT_DOUBLE_EQ(laws.range_factor(), 1.05);  // the neighbour list's cut-off follows it
+  EXPECT_FALSE(laws.needs_rotations());
+  // Explicit stability limit 2 R / k of the smallest pair, R the drag of two discs of radius
+  // 1/2 in series, 3 pi eta d / 2 (docs/model.md section 7).
+  EXPECT_NEAR(laws.explicit_stability_dt(), 2.0 * (3.0 * kPi / 2.0) / 100.0, 1e-12);
+
+  // Two small discs with coronas overlapping by 0.02 d: the pair's force is k 0.02 along the line
+  // of centres, pushing them apart, and the implicit block is dt k m m^T.
+  const PairGeometry g = PairGeometry::make(Vec2(1.03, 0.0), 0.5, 0.5);
+  const PairHistory none;
+  Mat6 m = Mat6::Constant(7.0);
+  Vec6 f = Vec6::Constant(7.0);
+  bool sliding = true;
+  ASSERT_TRUE(laws.add_blocks(g, none, 0.01, m, f, sliding));
+  EXPECT_NEAR(f(0), -100.0 * 0.02, 1e-12);  // on disc i, away from j (n = +x)
+  EXPECT_NEAR(f(3), +100.0 * 0.02, 1e-12);  // on disc j
+  EXPECT_NEAR(f.norm(), std::sqrt(2.0) * 2.0, 1e-12);
+  EXPECT_NEAR(m(0, 0), 0.01 * 100.0, 1e-12);
+  EXPECT_NEAR(m(0, 3), -0.01 * 100.0, 1e-12);
+  EXPECT_FALSE(sliding);
+  // Beyond the coronas nothing acts, and the block is left as it was.
+  const PairGeometry far = PairGeometry::make(Vec2(1.06, 0.0), 0.5, 0.5);
+  EXPECT_FALSE(laws.add_blocks(far, none, 0.01, m, f, sliding));
 }
 
 }  // namespace
