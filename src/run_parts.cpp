@@ -9,6 +9,7 @@
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/run_files.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
@@ -275,33 +276,34 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
   const Dynamics& d = run.sim.dynamics();
   const Particles& p = d.particles();
   nlohmann::json js;
-  js["version"] = version();
-  js["git_hash"] = git_hash();
-  js["host"] = host_name();
-  js["seed"] = cfg.run.seed;
+  js[summary_key::version] = version();
+  js[summary_key::git_hash] = git_hash();
+  js[summary_key::host] = host_name();
+  js[summary_key::seed] = cfg.run.seed;
   if (run.started >= 0)
-    js["started"] =
+    js[summary_key::started] =
         iso8601_utc(std::chrono::system_clock::time_point(std::chrono::seconds(run.started)));
   else
-    js["started"] = nullptr;
-  js["finished"] = iso8601_utc_now();
-  js["scene"] = cfg.scene.type;
-  js["N"] = static_cast<std::int64_t>(p.n_mobile);
-  if (scene_kind(cfg.scene.type).imposes_shear_rate()) js["J"] = cfg.flow.j;
-  js["ktilde"] = cfg.contact.ktilde;
-  js["integrator"] = to_string(cfg.integrator.type);
-  js["strain"] = d.strain();
-  js["steps"] = d.steps();
-  js["steps_per_strain"] = d.steps() / std::max(d.strain(), 1e-300);
-  js["wall_seconds"] = wall_seconds;
-  js["ms_per_step"] = 1e3 * wall_seconds / static_cast<double>(std::max<long>(d.steps(), 1));
-  js["neighbour_rebuilds"] = d.neighbours().rebuilds();
-  js["factorisations"] = d.force_balance().system().factorisations();
+    js[summary_key::started] = nullptr;
+  js[summary_key::finished] = iso8601_utc_now();
+  js[summary_key::scene] = cfg.scene.type;
+  js[summary_key::N] = static_cast<std::int64_t>(p.n_mobile);
+  if (scene_kind(cfg.scene.type).imposes_shear_rate()) js[summary_key::J] = cfg.flow.j;
+  js[summary_key::ktilde] = cfg.contact.ktilde;
+  js[summary_key::integrator] = to_string(cfg.integrator.type);
+  js[summary_key::strain] = d.strain();
+  js[summary_key::steps] = d.steps();
+  js[summary_key::steps_per_strain] = d.steps() / std::max(d.strain(), 1e-300);
+  js[summary_key::wall_seconds] = wall_seconds;
+  js[summary_key::ms_per_step] =
+      1e3 * wall_seconds / static_cast<double>(std::max<long>(d.steps(), 1));
+  js[summary_key::neighbour_rebuilds] = d.neighbours().rebuilds();
+  js[summary_key::factorisations] = d.force_balance().system().factorisations();
   {
     // Where factorisations beyond one per step come from (implicit springs at low J).
     const auto& sc = d.force_balance().sticking_counts();
     const double steps = static_cast<double>(std::max<long>(d.steps(), 1));
-    js["sticking_resolves_per_step"] = {
+    js[summary_key::sticking_resolves_per_step] = {
         {"low_rank", static_cast<double>(sc.low_rank) / steps},
         {"refactorised_budget", static_cast<double>(sc.refactorised_budget) / steps},
         {"refactorised_wall", static_cast<double>(sc.refactorised_wall) / steps},
@@ -315,18 +317,18 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
       if (counts[k] > 0)
         by[to_string(static_cast<StepLimit>(k))] =
             static_cast<double>(counts[k]) / static_cast<double>(std::max<long>(d.steps(), 1));
-    js["dt_limited_by"] = by;
+    js[summary_key::dt_limited_by] = by;
   }
-  js["lx"] = d.box().lx;
-  js["ly"] = d.height();
+  js[summary_key::lx] = d.box().lx;
+  js[summary_key::ly] = d.height();
   dir.with_hdf5_reasons([&] {
     for (const auto& o : run.observers) o->finish(d, js, trajectory.writer());
   });
   run.health.report(js);
-  if (!js.contains("phi")) {
+  if (!js.contains(summary_key::phi)) {
     double area = 0;
     for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
-    js["phi"] = area / (d.box().lx * d.height());
+    js[summary_key::phi] = area / (d.box().lx * d.height());
   }
   return js;
 }

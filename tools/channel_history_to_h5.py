@@ -29,6 +29,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rundir  # noqa: E402
 from channel_table import HISTORY_SERIES as SERIES, PROFILES  # noqa: E402
 
 
@@ -50,18 +51,18 @@ def write_history(h, y, file):
 
 def convert(run_dir):
     """True if the history was moved, False if there was none to move."""
-    summary = os.path.join(run_dir, "summary.json")
-    with open(summary) as fh:
-        s = json.load(fh)
+    run = rundir.Run(run_dir)
+    summary = str(run.file("summary"))
+    s = run.summary
     h = s.get("channel_history")
     if not h:
         return False
-    write_history(h, s["channel_y"], os.path.join(run_dir, "channel.h5"))
+    write_history(h, s["channel_y"], str(run.file("channel")))
     del s["channel_history"]
-    s["channel_history_file"] = "channel.h5"
+    s["channel_history_file"] = rundir.FILES["channel"]
     tmp = summary + ".tmp"
     with open(tmp, "w") as fh:   # the writer's layout: one key per line, sorted, lists inline
-        fh.write("{\n" + ",\n".join(f"  {json.dumps(k)}: {json.dumps(s[k])}" for k in sorted(s))
+        fh.write("{\n" + ",\n".join(f"  {json.dumps(k)}: {json.dumps(v)}" for k, v in sorted(s.items()))
                  + "\n}\n")
     os.replace(tmp, summary)
     return True
@@ -72,7 +73,7 @@ def main(argv=None):
     ap.add_argument("run_dirs", nargs="+", help="channel run directories (or stored points)")
     args = ap.parse_args(argv)
     for d in args.run_dirs:
-        if not os.path.isfile(os.path.join(d, "summary.json")):
+        if not rundir.Run(d).finished:
             print(f"channel_history_to_h5.py: {d}: no summary.json", file=sys.stderr)
             return 1
     for d in args.run_dirs:

@@ -72,7 +72,7 @@ def _num(x):
 def load_run(path):
     """The summary of a channel run, with the scalar width-average particle velocity under
     "u_p_mean" and the steady profiles under "profiles" (numpy arrays, nan for empty bins)."""
-    f = os.path.join(path, "summary.json")
+    f = str(rundir.Run(path).file("summary"))
     if not os.path.isfile(f):
         raise RunError(f"{path}: no summary.json (not a run directory, or the run has not finished)")
     try:

@@ -28,10 +28,10 @@ points of a step-size sweep against a sweep of a new step policy. An --only KEY 
 also has as an axis filters REF_DIR's points too (one ktilde of a sweep over several).
 """
 import argparse
-import csv
 import math
-import pathlib
 import sys
+
+import rundir
 
 QUANTITIES = [("phi", "phi"), ("mu", "mu"), ("dv", "dv / (gammadot d)"),
               ("psi", "Psi gammadot"), ("D", "D / (gammadot d^2)"),
@@ -48,7 +48,7 @@ def quantity(r, q):
         return float(r["shear_stress"]) / float(r["pressure"])
     if q == "pressure_viscosity":
         return float(r["pressure"]) / float(r["J"]) if r.get("pressure") and r.get("J") else None
-    return None if r.get(q) in (None, "") else float(r[q])
+    return None if r.get(rundir.key(q)) in (None, "") else float(r[q])
 
 
 def mean_sem(xs):
@@ -68,12 +68,13 @@ def g(x, p=3):
 
 def finished_rows(folder):
     """The finished points of a sweep folder or store (its sweep.csv), and its axes."""
-    path = pathlib.Path(folder) / "sweep.csv"
-    if not path.exists():
-        sys.exit(f"{path}: missing (run `sheardiff sweep SWEEP.toml --out DIR --collect` first)")
-    rows = [r for r in csv.DictReader(open(path)) if r["status"].startswith("done")]
+    store = rundir.Store(folder)
+    if not (store.path / rundir.SWEEP_CSV).is_file():
+        sys.exit(f"{folder}: no sweep.csv (run `sheardiff sweep SWEEP.toml --out DIR "
+                 "--collect` first)")
+    rows = store.rows(done=True)
     if not rows:
-        sys.exit(f"{path}: no finished points yet")
+        sys.exit(f"{folder}: no finished points yet")
     return rows, [k[len("axis."):] for k in rows[0]
                   if k.startswith("axis.") and k != "axis.run.seed"]
 

@@ -11,10 +11,11 @@ now, does not warn). `--check` exits 1 if results/README.md differs from what it
     /usr/bin/python3 tools/results_index.py --check    # ctest results_index_up_to_date
 """
 import argparse
-import json
 import pathlib
 import re
 import sys
+
+import rundir
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "results"
@@ -54,10 +55,11 @@ def row(folder, files):
         stores = [ln.strip().removeprefix("../") for ln in sources.read_text().splitlines()[1:]
                   if ln.strip()]
         files = ["fit over " + ", ".join(stores)]
-    summaries = [json.loads(p.read_text())
-                 for p in sorted(folder.glob("points/*/summary.json")) or
-                 sorted(folder.glob("*/summary.json")) or
-                 sorted(folder.glob("*/points/*/summary.json"))]
+    # A store's points, else a folder of runs, else a folder of stores (results/channel).
+    summaries = [rundir.read_summary(p)
+                 for p in sorted(folder.glob(f"{rundir.POINTS}/*/{rundir.FILES['summary']}")) or
+                 sorted(folder.glob(f"*/{rundir.FILES['summary']}")) or
+                 sorted(folder.glob(f"*/{rundir.POINTS}/*/{rundir.FILES['summary']}"))]
     if sources.exists():
         return f"| {folder.name} | {files[0]} | - | - | - | - |"
     js = sorted({s["J"] for s in summaries if "J" in s})

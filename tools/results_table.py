@@ -20,11 +20,11 @@ run's own error bar, the ratio to the reference and the difference in combined s
 
 (a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.0001_N=500_seed=1)
 """
-import csv
-import json
 import math
 import pathlib
 import sys
+
+import rundir
 
 
 def fmt(x, p=3):
@@ -67,10 +67,10 @@ def compare(paths):
     """Markdown table: each run's quantities against the first run's (the reference)."""
     runs = []
     for p in paths:
-        f = pathlib.Path(p) / "summary.json"
-        if not f.exists():
+        run = rundir.Run(p)
+        if not run.finished:
             sys.exit(f"{p}: no summary.json (a finished run's folder)")
-        runs.append(json.loads(f.read_text()))
+        runs.append(run.summary)
     ref = runs[0]
     print("| run | " + " | ".join(k for k, _ in COMPARED) + " |")
     print("|---" * (len(COMPARED) + 1) + "|")
@@ -103,11 +103,11 @@ def main():
     out = pathlib.Path(sys.argv[1])
     if not out.is_dir():
         sys.exit(f"{out}: not a directory")
-    if not (out / "fits.json").exists() or not (out / "sweep.csv").exists():
+    store = rundir.Store(out)
+    if not store.has_table():
         sys.exit(f"{out}: no fits.json / sweep.csv (run `sheardiff sweep SWEEP.toml --out DIR "
                  f"--collect` first)")
-    fits = json.loads((out / "fits.json").read_text())
-    rows = list(csv.DictReader(open(out / "sweep.csv")))
+    fits, rows = store.fits, store.rows()
     if not fits.get("groups"):
         sys.exit(f"{out}: fits.json has no J fits (a sweep without a flow.J axis, such as "
                  f"channel cases over seeds: tools/channel_table.py reads those)")
@@ -272,9 +272,9 @@ def subrange_fits(done, replicates=2000):
 
 
 def cell(r, k):
-    """A sweep.csv cell as a float, None where empty or not a number."""
+    """A sweep.csv cell (summary key k) as a float, None where empty or not a number."""
     try:
-        return float(r[k]) if r.get(k) not in (None, "") else None
+        return float(r[k]) if r.get(rundir.key(k)) not in (None, "") else None
     except ValueError:
         return None
 

@@ -1,24 +1,31 @@
-"""What every tool reads of a run directory, in one place.
+"""What every tool reads of a run directory or a sweep's store, in one place.
 
-The file names come from the C++ declaration (include/sheardiff/io/run_files.hpp), so the run,
-the run directory's rules and these tools cannot disagree on them. HDF5 files are opened in
+The file names come from the C++ declaration (include/sheardiff/io/run_files.hpp) and the
+summary.json keys from theirs (include/sheardiff/io/summary_keys.hpp), so the run, the run
+directory's rules and these tools cannot disagree on them: reading a key the code does not
+declare raises KeyError naming it, where a misspelt key would otherwise read as absent. HDF5 files are opened in
 single-writer/multiple-reader mode, so a trajectory can be read while its run writes it (the
 run flushes it every two seconds).
 
     import rundir
     run = rundir.Run("runs/quick")
-    run.summary        # summary.json as a dict ({} for an unfinished run)
+    run.summary        # summary.json as a Summary (a dict; {} for an unfinished run)
     run.config         # config.toml as a dict ({} if absent)
     with run.open("trajectory") as f: ...   # or "analysis", "channel"
+
+    store = rundir.Store("results/n1000_k1e4_steady")   # or a sweep folder
+    store.points()     # its finished points, each a Run
+    store.rows()       # sweep.csv as dicts; store.fits: fits.json
 """
 import json
 import pathlib
 import re
 import tomllib
 
-_HEADER = pathlib.Path(__file__).resolve().parent.parent / "include/sheardiff/io/run_files.hpp"
+_INCLUDE = pathlib.Path(__file__).resolve().parent.parent / "include/sheardiff/io"
+_HEADER = _INCLUDE / "run_files.hpp"
 # kAnalysisFile -> "analysis.h5", ..., read from the header's `inline constexpr const char* kX = "...";`
-NAMES = dict(re.findall(r'constexpr const char\* (k\w+) = "([^"]+)"', _HEADER.read_text()))
+NAMES = dict(re.findall(r'constexpr const char\*\s+(k\w+)\s*=\s*"([^"]+)"', _HEADER.read_text()))
 FILES = {
     "config": NAMES["kConfigFile"],
     "trajectory": NAMES["kTrajectoryFile"],
@@ -27,6 +34,38 @@ FILES = {
     "summary": NAMES["kSummaryFile"],
     "checkpoint": NAMES["kCheckpointFile"],
 }
+# A sweep's store (results/NAME) or folder: points/NAME/ run directories, the collected table
+# and fits (include/sheardiff/sweep/sweep.hpp, docs/sweeps.md).
+POINTS, SWEEP_CSV, FITS = "points", "sweep.csv", "fits.json"
+
+# Every summary.json key, from `inline constexpr const char* name = "name";`.
+SUMMARY_KEYS = frozenset(re.findall(r'constexpr const char\*\s+\w+\s*=\s*"([^"]+)"',
+                                    (_INCLUDE / "summary_keys.hpp").read_text()))
+
+
+class Summary(dict):
+    """A run's summary.json. Reading a key that is not declared raises KeyError; a declared key
+    the run did not write reads as absent, as in a dict."""
+
+    @staticmethod
+    def _declared(key):
+        if key not in SUMMARY_KEYS:
+            raise KeyError(f"{key!r} is not a summary.json key (include/sheardiff/io/summary_keys.hpp)")
+        return key
+
+    def __getitem__(self, key):
+        return super().__getitem__(self._declared(key))
+
+    def get(self, key, default=None):
+        return super().get(self._declared(key), default)
+
+    def __contains__(self, key):
+        return super().__contains__(self._declared(key))
+
+
+def key(name):
+    """name if it is a summary.json key (a sweep.csv column of a point's summary), else KeyError."""
+    return Summary._declared(name)
 
 
 def open_h5(path):
@@ -43,6 +82,11 @@ def open_h5(path):
 
 def read_json(path):
     return json.loads(pathlib.Path(path).read_text())
+
+
+def read_summary(path):
+    """A summary.json file as a Summary."""
+    return Summary(read_json(path))
 
 
 class Run:
@@ -66,11 +110,39 @@ class Run:
 
     @property
     def summary(self):
-        return read_json(self.file("summary")) if self.has("summary") else {}
+        return read_summary(self.file("summary")) if self.has("summary") else Summary()
 
     @property
     def config(self):
         return tomllib.loads(self.file("config").read_text()) if self.has("config") else {}
+
+
+class Store:
+    """A sweep's results store (results/NAME) or sweep folder, finished or not."""
+
+    def __init__(self, path):
+        self.path = pathlib.Path(path)
+
+    def points(self, finished=True):
+        """Its point run directories (points/NAME/), sorted by name; only the finished ones
+        unless finished=False."""
+        runs = [Run(p) for p in sorted((self.path / POINTS).glob("*")) if p.is_dir()]
+        return [r for r in runs if r.finished or not finished]
+
+    def has_table(self):
+        return (self.path / SWEEP_CSV).is_file() and (self.path / FITS).is_file()
+
+    def rows(self, done=False):
+        """sweep.csv as a list of dicts (cells as text); only the finished points if done."""
+        import csv
+
+        with open(self.path / SWEEP_CSV, newline="") as f:
+            rows = list(csv.DictReader(f))
+        return [r for r in rows if r["status"].startswith("done")] if done else rows
+
+    @property
+    def fits(self):
+        return read_json(self.path / FITS)
 
 
 def unwrapped_positions(group, frames=slice(None)):

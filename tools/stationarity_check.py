@@ -14,13 +14,12 @@
       can be read off.
 """
 import argparse
-import glob
-import json
 import math
-import os
 import sys
 
 import numpy as np
+
+import rundir
 
 
 SIGNALS = ("net_drag_y", "mu_top_minus_bottom", "H_change", "bulk_normal_load")
@@ -28,9 +27,8 @@ SIGNALS = ("net_drag_y", "mu_top_minus_bottom", "H_change", "bulk_normal_load")
 
 def store(path):
     rows = []
-    for f in sorted(glob.glob(os.path.join(path, "points", "*", "summary.json"))):
-        s = json.load(open(f))
-        name = os.path.basename(os.path.dirname(f))
+    for point in rundir.Store(path).points():
+        s, name = point.summary, point.path.name
         if "stationary" in s:
             verdict = "stationary" if s["stationary"] else "DRIFTING: " + s.get("not_stationary", "")
             signals = " | ".join(
@@ -68,13 +66,9 @@ def block_stats(x, t, lo, hi, blocks):
 
 
 def approach(run, window, block, z, tolerance):
-    import h5py
 
-    cfg_j = None
-    for line in open(os.path.join(run, "config.toml")):
-        if line.strip().startswith("J ="):
-            cfg_j = float(line.split("=")[1])
-    with h5py.File(os.path.join(run, "trajectory.h5"), "r", locking=False) as f:
+    cfg_j = rundir.Run(run).config["flow"]["J"]
+    with rundir.Run(run).open("trajectory") as f:
         o = f["observables"]
         # Time is in eta / P; strain = gammadot t = J t in these units (docs/units.md).
         t = o["H/time"][:] * cfg_j

@@ -11,10 +11,9 @@ a step does (solves, assembly, neighbour search, observers), so a real run costs
 
 Each directory is a results store or a sweep folder (its points/*/summary.json are read)."""
 import argparse
-import glob
-import json
-import pathlib
 import sys
+
+import rundir
 
 
 def main():
@@ -42,11 +41,10 @@ def main():
         only.append((key, value))
     groups = {}
     for d in a.dirs:
-        files = glob.glob(str(pathlib.Path(d) / "points" / "*" / "summary.json"))
-        if not files:
-            sys.exit(f"{d}: no points/*/summary.json (a results store or a sweep folder)")
-        for f in files:
-            s = json.load(open(f))
+        points = rundir.Store(d).points()
+        if not points:
+            sys.exit(f"{d}: no points finished in points/*/ (give a results store or a sweep folder)")
+        for s in (p.summary for p in points):
             if not s.get("steps") or "factorisations" not in s:
                 continue  # a summary from before the solver's counters
             if any(s.get(k) != v if k == "scene" else float(s.get(k, "nan")) != v

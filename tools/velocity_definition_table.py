@@ -11,9 +11,10 @@ ratios are within 2 sigma of 1 at every J.
     tools/velocity_definition_table.py results/velocity_definition_n250 [--out FILE]
 """
 import argparse
-import json
 import pathlib
 import sys
+
+import rundir
 
 
 def seed_dv(j):
@@ -26,8 +27,8 @@ def seed_psi(j):
 
 def load(store):
     rows = []
-    for f in sorted(pathlib.Path(store).glob("points/*/summary.json")):
-        s = json.loads(f.read_text())
+    for run in rundir.Store(store).points():
+        s = run.summary
         if "velocity_intervals" not in s or "dv" not in s:
             continue
         defs = [("instantaneous", s["dv"], s.get("dv_err"), s["psi"], s.get("psi_err"))]
@@ -35,7 +36,7 @@ def load(store):
             defs.append((f"Delta = {delta:g}", s["dv_intervals"][k], s["dv_intervals_err"][k],
                          s["psi_intervals"][k], s["psi_intervals_err"][k]))
         rows.append({"J": s["J"], "D": s["D"], "stationary": s.get("stationary"),
-                     "point": f.parent.name, "defs": defs})
+                     "point": run.path.name, "defs": defs})
     return sorted(rows, key=lambda r: r["J"])
 
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "sheardiff/io/summary_keys.hpp"
+
 namespace sheardiff {
 
 namespace {
@@ -346,48 +348,49 @@ DiffusionReport analyse_diffusion(const Eigen::MatrixXd& y, const Eigen::MatrixX
 }
 
 void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
-  js["D"] = r.fit.d;
-  js["D_err"] = number_or_null(r.d_error.err);
-  js["D_regression_stderr"] = r.fit.d_stderr;
-  js["D_all_reference_times"] = number_or_null(r.d_error.d);
-  js["dv"] = r.dv;
-  js["dv_err"] = number_or_null(r.vel.dv_err);
-  js["psi"] = r.persistence.psi;
-  js["psi_err"] = number_or_null(r.vel.psi_err);
-  js["psi_e"] = number_or_null(r.persistence.psi_e);
-  js["psi_e_err"] = number_or_null(r.vel.psi_e_err);
-  js["psi_zero"] = number_or_null(r.persistence.psi_zero);
-  js["psi_zero_err"] = number_or_null(r.vel.psi_zero_err);
-  js["psi_full"] = number_or_null(r.persistence.psi_full);
-  js["psi_full_err"] = number_or_null(r.vel.psi_full_err);
+  js[summary_key::D] = r.fit.d;
+  js[summary_key::D_err] = number_or_null(r.d_error.err);
+  js[summary_key::D_regression_stderr] = r.fit.d_stderr;
+  js[summary_key::D_all_reference_times] = number_or_null(r.d_error.d);
+  js[summary_key::dv] = r.dv;
+  js[summary_key::dv_err] = number_or_null(r.vel.dv_err);
+  js[summary_key::psi] = r.persistence.psi;
+  js[summary_key::psi_err] = number_or_null(r.vel.psi_err);
+  js[summary_key::psi_e] = number_or_null(r.persistence.psi_e);
+  js[summary_key::psi_e_err] = number_or_null(r.vel.psi_e_err);
+  js[summary_key::psi_zero] = number_or_null(r.persistence.psi_zero);
+  js[summary_key::psi_zero_err] = number_or_null(r.vel.psi_zero_err);
+  js[summary_key::psi_full] = number_or_null(r.persistence.psi_full);
+  js[summary_key::psi_full_err] = number_or_null(r.vel.psi_full_err);
   // D / dv^2: the persistence time a random walk with this D and dv would need.
-  js["psi_from_D"] = r.dv > 0 ? nlohmann::json(r.fit.d / (r.dv * r.dv)) : nlohmann::json(nullptr);
-  js["step_length"] = r.step_length;
-  js["diffusion_consistency"] = r.consistency;
-  js["msd_window"] = {r.window_lo, r.window_hi};
-  js["msd_window_slope"] = number_or_null(r.fit.loglog_slope);
-  js["error_block_strain"] = r.error_block;
-  js["error_blocks"] = r.vel.blocks;
+  js[summary_key::psi_from_D] =
+      r.dv > 0 ? nlohmann::json(r.fit.d / (r.dv * r.dv)) : nlohmann::json(nullptr);
+  js[summary_key::step_length] = r.step_length;
+  js[summary_key::diffusion_consistency] = r.consistency;
+  js[summary_key::msd_window] = {r.window_lo, r.window_hi};
+  js[summary_key::msd_window_slope] = number_or_null(r.fit.loglog_slope);
+  js[summary_key::error_block_strain] = r.error_block;
+  js[summary_key::error_blocks] = r.vel.blocks;
   if (r.has_bulk) {
-    js["bulk_fraction"] = r.bulk_fraction;
-    js["D_bulk"] = r.fit_bulk.d;
-    js["dv_bulk"] = r.vel_bulk.dv;
-    js["dv_bulk_err"] = number_or_null(r.vel_bulk.dv_err);
-    js["psi_bulk"] = r.vel_bulk.p.psi;
-    js["psi_bulk_err"] = number_or_null(r.vel_bulk.psi_err);
-    js["psi_e_bulk"] = number_or_null(r.vel_bulk.p.psi_e);
-    js["psi_full_bulk"] = number_or_null(r.vel_bulk.p.psi_full);
+    js[summary_key::bulk_fraction] = r.bulk_fraction;
+    js[summary_key::D_bulk] = r.fit_bulk.d;
+    js[summary_key::dv_bulk] = r.vel_bulk.dv;
+    js[summary_key::dv_bulk_err] = number_or_null(r.vel_bulk.dv_err);
+    js[summary_key::psi_bulk] = r.vel_bulk.p.psi;
+    js[summary_key::psi_bulk_err] = number_or_null(r.vel_bulk.psi_err);
+    js[summary_key::psi_e_bulk] = number_or_null(r.vel_bulk.p.psi_e);
+    js[summary_key::psi_full_bulk] = number_or_null(r.vel_bulk.p.psi_full);
   }
   if (r.has_x) {
-    js["D_x"] = number_or_null(r.fit_x.d);
-    js["msd_x_window_slope"] = number_or_null(r.fit_x.loglog_slope);
+    js[summary_key::D_x] = number_or_null(r.fit_x.d);
+    js[summary_key::msd_x_window_slope] = number_or_null(r.fit_x.loglog_slope);
   }
   if (!r.intervals.empty()) {
-    auto& v = js["velocity_intervals"] = nlohmann::json::array();
-    auto& dv = js["dv_intervals"] = nlohmann::json::array();
-    auto& dv_err = js["dv_intervals_err"] = nlohmann::json::array();
-    auto& psi = js["psi_intervals"] = nlohmann::json::array();
-    auto& psi_err = js["psi_intervals_err"] = nlohmann::json::array();
+    auto& v = js[summary_key::velocity_intervals] = nlohmann::json::array();
+    auto& dv = js[summary_key::dv_intervals] = nlohmann::json::array();
+    auto& dv_err = js[summary_key::dv_intervals_err] = nlohmann::json::array();
+    auto& psi = js[summary_key::psi_intervals] = nlohmann::json::array();
+    auto& psi_err = js[summary_key::psi_intervals_err] = nlohmann::json::array();
     for (const auto& iv : r.intervals) {
       v.push_back(iv.interval);
       dv.push_back(iv.vel.dv);
@@ -396,10 +399,10 @@ void add_to_summary(const DiffusionReport& r, nlohmann::json& js) {
       psi_err.push_back(number_or_null(iv.vel.psi_err));
     }
   }
-  js["analysis_samples"] = r.samples;
-  js["analysis_sample_strain"] = r.sample_strain;
-  js["analysis_coarse_strain"] = r.coarse_strain;
-  js["analysis_warnings"] = r.warnings;
+  js[summary_key::analysis_samples] = r.samples;
+  js[summary_key::analysis_sample_strain] = r.sample_strain;
+  js[summary_key::analysis_coarse_strain] = r.coarse_strain;
+  js[summary_key::analysis_warnings] = r.warnings;
 }
 
 }  // namespace sheardiff

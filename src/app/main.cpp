@@ -21,6 +21,7 @@
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/run.hpp"
@@ -158,7 +159,7 @@ struct CommandLine {
   void add_sweep();
   void add_fit();
   CLI::App app{"sheardiff: overdamped frictional DEM of dense non-Brownian suspensions"};
-  CLI::App *run, *check, *doc, *analyse, *sweep, *fit;
+  CLI::App *run, *check, *doc, *keys_doc, *analyse, *sweep, *fit;
   std::string config_path, out_dir = "out", resume_dir, run_dir, sweep_file, backend;
   std::vector<std::string> overrides, stores;
   bool overwrite = false, quiet = false, markdown = false, collect_only = false,
@@ -223,6 +224,13 @@ void CommandLine::add_check_and_doc() {
       "TOML file of the defaults (lines of at most 100 columns)");
   doc->add_flag("--markdown", markdown,
                 "Print the Markdown table instead (the one docs/config.md is made from)");
+
+  keys_doc = app.add_subcommand(
+      "summary-keys",
+      "Print every key a run may write to summary.json with its unit and meaning, as a JSON "
+      "list (what tools/rundir.py checks names against)");
+  keys_doc->add_flag("--markdown", markdown,
+                     "Print the Markdown tables instead (the ones docs/outputs.md holds)");
 }
 
 void CommandLine::add_analyse() {
@@ -456,6 +464,11 @@ int main(int argc, char** argv) {
     if (cl.doc->parsed()) {
       std::cout << (cl.markdown ? sheardiff::config_reference_markdown()
                                 : sheardiff::config_reference_text());
+      return 0;
+    }
+    if (cl.keys_doc->parsed()) {
+      std::cout << (cl.markdown ? sheardiff::summary_keys_markdown()
+                                : sheardiff::summary_keys_json().dump(1) + "\n");
       return 0;
     }
     if (cl.analyse->parsed()) return analyse_command(cl, dir);

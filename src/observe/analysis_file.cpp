@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "sheardiff/io/hdf5_tables.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 
 namespace sheardiff {
 
@@ -48,21 +49,21 @@ void write_analysis_file(const DiffusionReport& r, const std::filesystem::path& 
                    "the VACF over origins in the bulk");
     }
     H5Id root{H5Gopen2(f, "/", H5P_DEFAULT), H5Gclose};
-    write_attribute(root.id, "D", r.fit.d);
-    write_attribute(root.id, "D_err", r.d_error.err);
-    write_attribute(root.id, "D_regression_stderr", r.fit.d_stderr);
+    write_attribute(root.id, summary_key::D, r.fit.d);
+    write_attribute(root.id, summary_key::D_err, r.d_error.err);
+    write_attribute(root.id, summary_key::D_regression_stderr, r.fit.d_stderr);
     write_attribute(root.id, "msd_intercept", r.fit.intercept);
     write_attribute(root.id, "msd_window_lo", r.window_lo);
     write_attribute(root.id, "msd_window_hi", r.window_hi);
-    write_attribute(root.id, "msd_window_slope", r.fit.loglog_slope);
-    write_attribute(root.id, "dv", r.dv);
-    write_attribute(root.id, "psi", r.persistence.psi);
-    write_attribute(root.id, "psi_e", r.persistence.psi_e);
-    write_attribute(root.id, "psi_zero", r.persistence.psi_zero);
-    write_attribute(root.id, "psi_full", r.persistence.psi_full);
-    write_attribute(root.id, "psi_err", r.vel.psi_err);
-    write_attribute(root.id, "dv_err", r.vel.dv_err);
-    write_attribute(root.id, "step_length", r.step_length);
+    write_attribute(root.id, summary_key::msd_window_slope, r.fit.loglog_slope);
+    write_attribute(root.id, summary_key::dv, r.dv);
+    write_attribute(root.id, summary_key::psi, r.persistence.psi);
+    write_attribute(root.id, summary_key::psi_e, r.persistence.psi_e);
+    write_attribute(root.id, summary_key::psi_zero, r.persistence.psi_zero);
+    write_attribute(root.id, summary_key::psi_full, r.persistence.psi_full);
+    write_attribute(root.id, summary_key::psi_err, r.vel.psi_err);
+    write_attribute(root.id, summary_key::dv_err, r.vel.dv_err);
+    write_attribute(root.id, summary_key::step_length, r.step_length);
     write_attribute(root.id, "sample_strain", r.sample_strain);
     write_attribute(root.id, "coarse_strain", r.coarse_strain);
     if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw std::runtime_error("flush");

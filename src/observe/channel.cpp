@@ -9,6 +9,7 @@
 
 #include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/io/hdf5_tables.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/observe/profiles.hpp"
 
 namespace sheardiff {
@@ -267,21 +268,21 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
   };
   const std::vector<Interval> all = intervals(d);
   const ChannelHistory h = history_of(all);
-  js["channel_y"] = h.y;
-  js["channel_H_over_a"] = height_ / a_;
-  js["channel_phi_bulk"] = phi_b_;
-  js["channel_mean_velocity"] = u_mean_;
-  js["channel_coupling"] = d.force_balance().fluid() ? "two_way" : "one_way";
+  js[summary_key::channel_y] = h.y;
+  js[summary_key::channel_H_over_a] = height_ / a_;
+  js[summary_key::channel_phi_bulk] = phi_b_;
+  js[summary_key::channel_mean_velocity] = u_mean_;
+  js[summary_key::channel_coupling] = d.force_balance().fluid() ? "two_way" : "one_way";
   js["channel_pressure_gradient_poiseuille"] = g0_;
   if (!history_file_.empty()) {
     write_channel_history(h, history_file_);
-    js["channel_history_file"] = history_file_.filename().string();
+    js[summary_key::channel_history_file] = history_file_.filename().string();
   }
 
   // The steady state: from the detected time, else the second half of the run (flagged).
   const bool steady = steady_time_ >= 0.0;
-  js["channel_steady"] = steady;
-  js["channel_steady_time"] = steady ? nlohmann::json(steady_time_) : nlohmann::json();
+  js[summary_key::channel_steady] = steady;
+  js[summary_key::channel_steady_time] = steady ? nlohmann::json(steady_time_) : nlohmann::json();
   double from = steady ? steady_time_ : 0.0;
   if (!steady && !all.empty()) from = 0.5 * all.back().end;
   Interval sum;
@@ -289,7 +290,7 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
   for (const Interval& s : all)
     if (s.start >= from - 1e-9) sum.add(s);
   if (sum.w <= 0.0) return;
-  js["channel_average_from"] = from;
+  js[summary_key::channel_average_from] = from;
   const auto pr = profiles(sum);
   for (int k = 0; k < 5; ++k)
     js[std::string("channel_") + ChannelHistory::profile_names[k]] = list(pr[k]);
@@ -302,13 +303,13 @@ void ChannelObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* 
   for (std::size_t b = 0; b < bins_; ++b) {
     if (std::isfinite(pr[1][b])) up_sum += pr[1][b], up_n += 1, q += pr[0][b] * pr[1][b];
   }
-  js["channel_u_c"] = centre(pr[1]);
-  js["channel_phi_c"] = centre(pr[0]);
-  js["channel_u_p_mean"] = up_n > 0 ? nlohmann::json(up_sum / up_n) : nlohmann::json();
-  js["channel_Q_p"] = q / static_cast<double>(bins_) / phi_b_;
-  js["channel_dp_ratio"] = sum.g / sum.w;
-  js["channel_centre_distance"] = sum.centre / sum.w;
-  js["channel_mean_particle_velocity"] = sum.up / sum.w / u_mean_;
+  js[summary_key::channel_u_c] = centre(pr[1]);
+  js[summary_key::channel_phi_c] = centre(pr[0]);
+  js[summary_key::channel_u_p_mean] = up_n > 0 ? nlohmann::json(up_sum / up_n) : nlohmann::json();
+  js[summary_key::channel_Q_p] = q / static_cast<double>(bins_) / phi_b_;
+  js[summary_key::channel_dp_ratio] = sum.g / sum.w;
+  js[summary_key::channel_centre_distance] = sum.centre / sum.w;
+  js[summary_key::channel_mean_particle_velocity] = sum.up / sum.w / u_mean_;
 }
 
 }  // namespace sheardiff

@@ -11,6 +11,7 @@
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/run_files.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/analysis_file.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
@@ -116,7 +117,7 @@ void DiffusionObserver::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*)
     if (!file_.empty()) write_analysis_file(r, file_);
   } catch (const std::invalid_argument& e) {
     // Too little data for the fits is a finding about the run, not a reason to lose it.
-    js["analysis_warnings"] = {fmt::format("no diffusion analysis: {}", e.what())};
+    js[summary_key::analysis_warnings] = {fmt::format("no diffusion analysis: {}", e.what())};
   }
 }
 
@@ -128,8 +129,8 @@ nlohmann::json merge_analysis(const nlohmann::json& run, const nlohmann::json& c
                               std::vector<std::string>& differs) {
   nlohmann::json out = run;
   for (const auto& [key, value] : computed.items()) {
-    if (key == "analysis_warnings") {
-      nlohmann::json w = run.value("analysis_warnings", nlohmann::json::array());
+    if (key == summary_key::analysis_warnings) {
+      nlohmann::json w = run.value(summary_key::analysis_warnings, nlohmann::json::array());
       for (const auto& line : value)
         if (std::find(w.begin(), w.end(), line) == w.end()) w.push_back(line);
       out[key] = w;
@@ -245,11 +246,11 @@ Reanalysis write_reanalysis(const std::filesystem::path& dir, const nlohmann::js
                             const std::vector<std::string>& overrides) {
   Reanalysis out;
   out.summary = merge_analysis(run, computed, out.differs);
-  if (!overrides.empty()) out.summary["analysed_with"] = overrides;
+  if (!overrides.empty()) out.summary[summary_key::analysed_with] = overrides;
   out.folder = out.differs.empty() && overrides.empty() ? dir : dir / "reanalysis";
   const bool summary_changes = out.summary != run;
   // The run's own version stays; the analysis says which code recomputed it.
-  if (summary_changes) out.summary["analysed_by"] = version_line();
+  if (summary_changes) out.summary[summary_key::analysed_by] = version_line();
   const bool beside = out.folder != dir;
   if (beside) std::filesystem::create_directories(out.folder);
   if (report && (beside || !std::filesystem::exists(dir / kAnalysisFile)))
@@ -280,9 +281,10 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
   // The measured window: frames from the detection of steady state (pressure cell) or after
   // the transient (simple shear), the same test the observers applied while running.
   const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state();
-  if (pressure && !run.value("steady", false))
+  if (pressure && !run.value(summary_key::steady, false))
     throw std::runtime_error(fmt::format("{}: the run never reached steady state", dir.string()));
-  const double from = pressure ? run["steady_detected_at"].get<double>() : cfg.run.transient_strain;
+  const double from =
+      pressure ? run[summary_key::steady_detected_at].get<double>() : cfg.run.transient_strain;
   const ObservableSeries strain = read_h5md_observable(traj, "strain");
   std::vector<long> frames;
   for (std::size_t k = 0; k < strain.value.size(); ++k)
@@ -293,7 +295,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
         fmt::format("{}: only {} frames in the measured window", dir.string(), frames.size()));
   // The run measured its profiles at every step; frames can only approximate them, so they are
   // computed here only for a run that has none (an older version's).
-  const bool want_profiles = pressure && !run.contains("profile_phi");
+  const bool want_profiles = pressure && !run.contains(summary_key::profile_phi);
   WindowFrames w = read_window(traj, frames, cfg, want_profiles);
   Eigen::MatrixXd mask;
   if (w.walls) mask = bulk_mask(w.y, w.bottom, w.top, cfg.observables.wall_exclusion);
@@ -305,7 +307,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
     add_to_summary(*report, computed);
   } catch (const std::invalid_argument& e) {
     // As in the run: too little data for the fits is a finding, the rest is still computed.
-    computed["analysis_warnings"] = {fmt::format("no diffusion analysis: {}", e.what())};
+    computed[summary_key::analysis_warnings] = {fmt::format("no diffusion analysis: {}", e.what())};
   }
   if (pressure) {
     add_window_keys(traj, cfg, strain.value, from,
@@ -313,7 +315,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
     if (want_profiles && w.walls) {
       w.profiles.to_summary(computed, cfg.flow.j, w.height_sum / static_cast<double>(frames.size()),
                             cfg.observables.wall_exclusion);
-      computed["profiles_from"] = "frames";
+      computed[summary_key::profiles_from] = "frames";
     }
   }
   return write_reanalysis(dir, run, computed, report, overrides);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "sheardiff/io/summary_keys.hpp"
+
 namespace sheardiff {
 
 std::vector<std::string> RheologyObserver::frame_names() const {
@@ -30,20 +32,23 @@ void RheologyObserver::on_step(const StepView& v) {
 }
 
 void RheologyObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
-  js["max_overlap"] = max_overlap_;
-  js["averaged_from_strain"] = transient_;
+  js[summary_key::max_overlap] = max_overlap_;
+  js[summary_key::averaged_from_strain] = transient_;
   if (weight_ <= 0.0) {
     // Nothing to average: the run ended before run.transient_strain.
-    for (const char* k : {"mean_overlap", "shear_stress", "pressure", "contacts_per_particle", "viscosity"})
+    for (const char* k :
+         {summary_key::mean_overlap, summary_key::shear_stress, summary_key::pressure,
+          summary_key::contacts_per_particle, summary_key::viscosity})
       js[k] = nullptr;
     return;
   }
   const double w = weight_;
-  js["mean_overlap"] = mean_overlap_ / w;
-  js["shear_stress"] = sxy_ / w;
-  js["pressure"] = pressure_ / w;
-  js["contacts_per_particle"] = contacts_ / w / static_cast<double>(d.particles().n_mobile);
-  js["viscosity"] = d.flow().gammadot > 0 ? sxy_ / w / d.flow().gammadot : 0.0;
+  js[summary_key::mean_overlap] = mean_overlap_ / w;
+  js[summary_key::shear_stress] = sxy_ / w;
+  js[summary_key::pressure] = pressure_ / w;
+  js[summary_key::contacts_per_particle] =
+      contacts_ / w / static_cast<double>(d.particles().n_mobile);
+  js[summary_key::viscosity] = d.flow().gammadot > 0 ? sxy_ / w / d.flow().gammadot : 0.0;
 }
 
 }  // namespace sheardiff

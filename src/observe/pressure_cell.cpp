@@ -9,6 +9,7 @@
 #include "sheardiff/analysis/uncertainty.hpp"
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/h5md.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 
 namespace sheardiff {
 
@@ -31,7 +32,7 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
   const long n = to > from ? frames_between(strain, from, to) : 0;
   if (n < kMinWindowFrames) {
     // Said rather than printed as "+- nan": too few frames to form blocks from.
-    js["steady_errors_note"] = fmt::format(
+    js[summary_key::steady_errors_note] = fmt::format(
         "no error bars: {} frames in the measured window, {} needed (lower output.frame_strain "
         "or measure longer)",
         n, kMinWindowFrames);
@@ -44,11 +45,11 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
     const double e = batch_means(strain, x, from, to, blocks).err;
     return std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr);
   };
-  js["H_err"] = err(h);
-  js["phi_err"] = err(phi);
-  js["mu_err"] = err(mu);
-  js["mu_top_err"] = err(mu_top);
-  js["mu_bottom_err"] = err(mu_bottom);
+  js[summary_key::H_err] = err(h);
+  js[summary_key::phi_err] = err(phi);
+  js[summary_key::mu_err] = err(mu);
+  js[summary_key::mu_top_err] = err(mu_top);
+  js[summary_key::mu_bottom_err] = err(mu_bottom);
 }
 
 StationarityVerdict pressure_cell_stationarity(
@@ -63,12 +64,12 @@ StationarityVerdict pressure_cell_stationarity(
   for (std::size_t k = 0; k < dmu.size(); ++k) dmu[k] = mu_top[k] - mu_bottom[k];
   const double z = cfg.drift_z;
   v.signals.push_back(
-      mean_within_noise("net_drag_y", strain, net_drag_y, 0.0, from, to, blocks, z));
+      mean_within_noise(summary_key::net_drag_y, strain, net_drag_y, 0.0, from, to, blocks, z));
   v.signals.push_back(
-      mean_within_noise("mu_top_minus_bottom", strain, dmu, 0.0, from, to, blocks, z));
-  v.signals.push_back(trend_within_noise("H_change", strain, h, from, to, blocks, z));
-  v.signals.push_back(mean_within_tolerance("bulk_normal_load", strain, bulk_load, 1.0, from, to,
-                                            blocks, cfg.bulk_load_tolerance));
+      mean_within_noise(summary_key::mu_top_minus_bottom, strain, dmu, 0.0, from, to, blocks, z));
+  v.signals.push_back(trend_within_noise(summary_key::H_change, strain, h, from, to, blocks, z));
+  v.signals.push_back(mean_within_tolerance(summary_key::bulk_normal_load, strain, bulk_load, 1.0,
+                                            from, to, blocks, cfg.bulk_load_tolerance));
   return v;
 }
 
@@ -76,17 +77,18 @@ void add_stationarity(nlohmann::json& js, const StationarityVerdict& v) {
   const auto num = [](double x) {
     return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
   };
-  js["stationary"] = v.stationary();
-  js["not_stationary"] = v.signals.empty() ? std::string("window too short") : v.failed();
+  js[summary_key::stationary] = v.stationary();
+  js[summary_key::not_stationary] =
+      v.signals.empty() ? std::string("window too short") : v.failed();
   for (const DriftSignal& s : v.signals) {
     js[s.name] = num(s.expected + s.value);
     js[s.name + "_err"] = num(s.err);
   }
   if (!v.stationary())
-    js["stationarity_warning"] = fmt::format(
+    js[summary_key::stationarity_warning] = fmt::format(
         "the measured window is not stationary ({}): its averages describe a transient; run "
         "longer or start nearer the steady state (docs/model.md, \"Steady state\")",
-        js["not_stationary"].get<std::string>());
+        js[summary_key::not_stationary].get<std::string>());
 }
 
 namespace {
@@ -216,31 +218,33 @@ bool PressureCellObserver::done(const Dynamics& d) const {
 }
 
 void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
-  js["steady"] = steady();
-  js["steady_strain"] = steady() ? nlohmann::json(steady_from_) : nlohmann::json(nullptr);
-  js["steady_detected_at"] = steady() ? nlohmann::json(steady_at_) : nlohmann::json(nullptr);
+  js[summary_key::steady] = steady();
+  js[summary_key::steady_strain] =
+      steady() ? nlohmann::json(steady_from_) : nlohmann::json(nullptr);
+  js[summary_key::steady_detected_at] =
+      steady() ? nlohmann::json(steady_at_) : nlohmann::json(nullptr);
   // Over every step where the packing holds the wall (free-fall steps are counted apart).
-  js["pressure_max_relative_error"] = max_p_err_;
-  js["wall_free_fall_steps"] = free_fall_steps_;
+  js[summary_key::pressure_max_relative_error] = max_p_err_;
+  js[summary_key::wall_free_fall_steps] = free_fall_steps_;
   if (!steady() || w_ <= 0.0) {
-    js["steady"] = false;
-    js["note"] = steady()
-                     ? "steady state detected at the last step: nothing measured after it; "
-                       "run longer (run.strain)"
-                     : "steady state not reached: H or mu still drift; run longer (run.strain)";
-    js["H"] = d.height();
-    js["phi"] = bulk_phi(d, exclusion_);
+    js[summary_key::steady] = false;
+    js[summary_key::note] =
+        steady() ? "steady state detected at the last step: nothing measured after it; "
+                   "run longer (run.strain)"
+                 : "steady state not reached: H or mu still drift; run longer (run.strain)";
+    js[summary_key::H] = d.height();
+    js[summary_key::phi] = bulk_phi(d, exclusion_);
     return;
   }
   const double phi = phi_ / w_;
-  js["H"] = h_ / w_;
-  js["phi"] = phi;
-  js["phi_std"] = std::sqrt(std::max(0.0, phi2_ / w_ - phi * phi));
-  js["mu"] = 0.5 * (mu_top_ + mu_bottom_) / w_;
-  js["mu_top"] = mu_top_ / w_;
-  js["mu_bottom"] = mu_bottom_ / w_;
-  js["pressure_measured"] = p_meas_ / w_;
-  js["measured_strain"] = d.strain() - steady_at_;
+  js[summary_key::H] = h_ / w_;
+  js[summary_key::phi] = phi;
+  js[summary_key::phi_std] = std::sqrt(std::max(0.0, phi2_ / w_ - phi * phi));
+  js[summary_key::mu] = 0.5 * (mu_top_ + mu_bottom_) / w_;
+  js[summary_key::mu_top] = mu_top_ / w_;
+  js[summary_key::mu_bottom] = mu_bottom_ / w_;
+  js[summary_key::pressure_measured] = p_meas_ / w_;
+  js[summary_key::measured_strain] = d.strain() - steady_at_;
   // The window's blocks span its frames, first to last: what `sheardiff analyse` sees too.
   const double last = s_strain_.empty() ? d.strain() : s_strain_.back();
   add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, last,

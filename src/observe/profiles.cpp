@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sheardiff/analysis/power_law.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 
 namespace sheardiff {
 
@@ -96,20 +97,20 @@ void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
     if (n_[b] > 0 && t(b, 0) >= exclusion && t(b, 0) <= height - exclusion)
       yb.push_back(t(b, 0)), uxb.push_back(t(b, 2) / gammadot);
   }
-  js["profile_y"] = y;
-  js["profile_phi"] = phi;
-  js["profile_u_x"] = ux;  // in gammadot d (the imposed flow is y)
-  js["profile_T"] = temp;  // in (gammadot d)^2
-  js["profile_bin"] = bin_;
-  if (yb.size() >= 3) js["bulk_shear_rate_ratio"] = fit_line(yb, uxb).slope;
+  js[summary_key::profile_y] = y;
+  js[summary_key::profile_phi] = phi;
+  js[summary_key::profile_u_x] = ux;  // in gammadot d (the imposed flow is y)
+  js[summary_key::profile_T] = temp;  // in (gammadot d)^2
+  js[summary_key::profile_bin] = bin_;
+  if (yb.size() >= 3) js[summary_key::bulk_shear_rate_ratio] = fit_line(yb, uxb).slope;
   if (sxy_.size() == w_.size()) {
     std::vector<double> sxy(w_.size()), sp(w_.size());
     for (std::size_t b = 0; b < w_.size(); ++b) {
       sxy[b] = w_[b] > 0 ? sxy_[b] / w_[b] : 0.0;
       sp[b] = w_[b] > 0 ? sp_[b] / w_[b] : 0.0;
     }
-    js["profile_shear_stress"] = sxy;  // sigma_xy of the pair forces, P
-    js["profile_pressure"] = sp;       // -(sigma_xx + sigma_yy) / 2 of the pair forces, P
+    js[summary_key::profile_shear_stress] = sxy;  // sigma_xy of the pair forces, P
+    js[summary_key::profile_pressure] = sp;  // -(sigma_xx + sigma_yy) / 2 of the pair forces, P
   }
 }
 

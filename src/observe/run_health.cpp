@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 
 namespace sheardiff {
 
@@ -200,10 +201,10 @@ HealthReport RunHealth::solver_failure(const Dynamics& d, const Velocities& v) c
 }
 
 void RunHealth::report(nlohmann::json& js) const {
-  js["health"] = {{"max_overlap", max_overlap_seen_},
-                  {"max_residual", max_residual_seen_},
-                  {"max_overlap_limit", max_overlap_},
-                  {"max_residual_limit", max_residual_}};
+  js[summary_key::health] = {{"max_overlap", max_overlap_seen_},
+                             {"max_residual", max_residual_seen_},
+                             {"max_overlap_limit", max_overlap_},
+                             {"max_residual_limit", max_residual_}};
 }
 
 void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, const Velocities& v,

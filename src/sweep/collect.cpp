@@ -13,6 +13,7 @@
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
+#include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/io/text.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
@@ -116,8 +117,8 @@ std::string window_verdict(const json& summary) {
   const auto is_false = [&](const char* key) {
     return summary.contains(key) && summary[key].is_boolean() && !summary[key].get<bool>();
   };
-  if (is_false("steady")) return "done, not steady";
-  if (is_false("stationary")) return "done, not stationary";
+  if (is_false(summary_key::steady)) return "done, not steady";
+  if (is_false(summary_key::stationary)) return "done, not stationary";
   return "";
 }
 
@@ -192,12 +193,12 @@ json seed_reference() {
 json fit_group(const std::vector<json>& rows) {
   std::vector<double> J, phi, mu, D, dv, psi;
   for (const auto& r : rows) {
-    J.push_back(num(r, "J"));
-    phi.push_back(num(r, "phi"));
-    mu.push_back(num(r, "mu"));
-    D.push_back(num(r, "D"));
-    dv.push_back(num(r, "dv"));
-    psi.push_back(num(r, "psi"));
+    J.push_back(num(r, summary_key::J));
+    phi.push_back(num(r, summary_key::phi));
+    mu.push_back(num(r, summary_key::mu));
+    D.push_back(num(r, summary_key::D));
+    dv.push_back(num(r, summary_key::dv));
+    psi.push_back(num(r, summary_key::psi));
   }
   json fits;
   fits["D_vs_J"] = power_fit(J, D);
@@ -240,7 +241,8 @@ json seed_bootstrap(const std::map<double, std::vector<json>>& by_j, long replic
       json row{{"J", j}};
       std::vector<std::size_t> pick;
       for (std::size_t k = 0; k < runs.size(); ++k) pick.push_back(rng() % runs.size());
-      for (const char* q : {"phi", "mu", "D", "dv", "psi"}) {
+      for (const char* q :
+           {summary_key::phi, summary_key::mu, summary_key::D, summary_key::dv, summary_key::psi}) {
         double mean = 0;
         long n_all = 0;
         for (const auto& run : runs)
@@ -290,7 +292,8 @@ json fits_of_group(const std::map<double, std::vector<json>>& by_j, const json& 
   std::vector<json> rows;
   for (const auto& [j, runs] : by_j) {
     json r{{"J", j}, {"runs", runs.size()}};
-    for (const char* q : {"phi", "mu", "D", "dv", "psi", "H"}) {
+    for (const char* q : {summary_key::phi, summary_key::mu, summary_key::D, summary_key::dv,
+                          summary_key::psi, summary_key::H}) {
       double s = 0, s2 = 0;
       long n = 0;
       for (const auto& run : runs) {
@@ -360,8 +363,8 @@ struct Collection {
     for (auto& [k, v] : flat) summary_keys.insert(k), row[k] = v;
     const std::string verdict = window_verdict(summary);
     if (!verdict.empty()) row["status"] = verdict;
-    if (placed && verdict.empty() && summary.contains("J")) {
-      groups[group_key][summary["J"].get<double>()].push_back(summary);
+    if (placed && verdict.empty() && summary.contains(summary_key::J)) {
+      groups[group_key][summary[summary_key::J].get<double>()].push_back(summary);
       group_axes[group_key] = axes;
     } else if (placed) {
       group_axes[group_key] = axes;
@@ -524,7 +527,7 @@ json fits_json(const SweepSpec& spec, std::size_t listed, Collection& c) {
   for (auto& [key, by_j] : c.groups)
     for (auto& [j, runs] : by_j)
       std::stable_sort(runs.begin(), runs.end(), [](const json& a, const json& b) {
-        return a.value("seed", 0L) < b.value("seed", 0L);
+        return a.value(summary_key::seed, 0L) < b.value(summary_key::seed, 0L);
       });
   for (const auto& [key, by_j] : c.groups)
     fits["groups"].push_back(fits_of_group(by_j, c.group_axes[key]));
@@ -566,11 +569,12 @@ namespace {
 // Why a finished point's measurement is left out of a combined fit, or "" to keep it.
 std::string exclusion(const json& summary, double drift_z) {
   if (const auto verdict = window_verdict(summary); !verdict.empty()) return verdict;
-  if (summary.contains("stationary")) return "";
+  if (summary.contains(summary_key::stationary)) return "";
   // Written before the stationarity test: of its signals only the walls' mu are stored. Their
   // errors are combined as if independent (the difference's own noise is not stored).
-  const double d = num(summary, "mu_top") - num(summary, "mu_bottom");
-  const double e = std::hypot(num(summary, "mu_top_err"), num(summary, "mu_bottom_err"));
+  const double d = num(summary, summary_key::mu_top) - num(summary, summary_key::mu_bottom);
+  const double e =
+      std::hypot(num(summary, summary_key::mu_top_err), num(summary, summary_key::mu_bottom_err));
   if (!std::isfinite(d) || !std::isfinite(e)) return "";  // no walls: nothing to judge by
   return std::abs(d) > drift_z * e ? "done, drifting (mu_top - mu_bottom)" : "";
 }
@@ -609,7 +613,7 @@ std::vector<std::pair<fs::path, json>> store_summaries(const fs::path& store) {
       throw ConfigError(fmt::format("fit: {}: not a valid summary: {}",
                                     (dir / "summary.json").string(), e.what()));
     }
-    if (!summary.contains("J") || !summary["J"].is_number()) continue;
+    if (!summary.contains(summary_key::J) || !summary[summary_key::J].is_number()) continue;
     here.emplace_back(dir, std::move(summary));
   }
   return here;
@@ -638,7 +642,7 @@ struct Combination {
         throw ConfigError(fmt::format(
             "fit: {} ({}) and {} ({}) are not one group: fit stores of the same physics", name, id,
             identity_of, identity));
-      const double j = summary["J"].get<double>();
+      const double j = summary[summary_key::J].get<double>();
       js_here.insert(j);
       Row row;
       row["point"] = name;

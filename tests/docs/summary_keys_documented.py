@@ -1,10 +1,11 @@
 #!/usr/bin/python3
-"""ctest: every key a run writes to summary.json is documented in docs/outputs.md.
+"""ctest: every key a run writes to summary.json is declared (include/sheardiff/io/summary_keys.hpp).
 
 Runs a small simple-shear run and a small pressure-cell run (both with the diffusion analysis)
-and a short channel run, then reads the keys of their summary.json files; each must appear as
-the first cell of a table row of docs/outputs.md, in backticks. Fails naming the keys that are
-not, so that a new key cannot go undocumented. Every dataset of their analysis.h5 and channel.h5
+and a short channel run, then reads the keys of their summary.json files; each must be in the
+list `sheardiff summary-keys` prints, the declaration docs/outputs.md's tables are printed from
+(ctest summary_keys_doc_up_to_date) and tools/rundir.py reads. Fails naming the keys that are
+not, so that a new key cannot go undeclared or undocumented. Every dataset of their analysis.h5 and channel.h5
 must carry "unit" and "description" attributes (issue 34: the files described nothing).
 
     summary_keys_documented.py --bin build/sheardiff --root . --work DIR
@@ -12,7 +13,6 @@ must carry "unit" and "description" attributes (issue 34: the files described no
 import argparse
 import json
 import pathlib
-import re
 import shutil
 import subprocess
 import sys
@@ -67,13 +67,9 @@ frame_strain = 0.02
 }
 
 
-def documented_keys(doc):
-    keys = set()
-    for line in doc.read_text().splitlines():
-        m = re.match(r"^\|\s*`([^`]+)`\s*\|", line)
-        if m:
-            keys.add(m.group(1))
-    return keys
+def declared_keys(binary):
+    out = subprocess.run([binary, "summary-keys"], capture_output=True, text=True, check=True).stdout
+    return {row["key"] for row in json.loads(out)}
 
 
 def main():
@@ -100,7 +96,22 @@ def main():
         sys.exit(f"channel: sheardiff run failed ({p.returncode}): {p.stderr}")
     summaries["channel"] = json.loads((out / "summary.json").read_text())
 
-    documented = documented_keys(args.root / "docs" / "outputs.md")
+    documented = declared_keys(args.bin)
+    # The names of the header (what tools/rundir.py reads) are exactly the documented rows, and
+    # a tool reading a misspelt key is stopped.
+    sys.path.insert(0, str(args.root / "tools"))
+    import rundir
+
+    if rundir.SUMMARY_KEYS != documented:
+        sys.exit(f"FAIL  header constants without a row: {sorted(rundir.SUMMARY_KEYS - documented)}; "
+                 f"rows without a constant: {sorted(documented - rundir.SUMMARY_KEYS)}")
+    try:
+        rundir.Summary({"psi": 1.0}).get("Psi")
+        sys.exit("FAIL  rundir.Summary read the undeclared key 'Psi'")
+    except KeyError:
+        pass
+    print(f"ok    the {len(documented)} declared keys are the {len(rundir.SUMMARY_KEYS)} names "
+          "tools/rundir.py reads; an undeclared key is refused")
     missing = sorted({(k, name) for name, s in summaries.items() for k in s if k not in documented})
     seen = set().union(*(s.keys() for s in summaries.values()))
     print(f"{len(seen)} keys in {len(summaries)} summaries, {len(documented)} documented")
@@ -123,9 +134,9 @@ def main():
         print("ok    every dataset of analysis.h5 and channel.h5 has a unit and a description")
     if missing or bare:
         for key, name in missing:
-            print(f"FAIL  `{key}` ({name}) is not documented in docs/outputs.md")
+            print(f"FAIL  `{key}` ({name}) is not declared in include/sheardiff/io/summary_keys.hpp")
         sys.exit(1)
-    print("ok    every summary.json key is documented in docs/outputs.md")
+    print("ok    every summary.json key is declared (and so documented in docs/outputs.md)")
 
 
 if __name__ == "__main__":
