@@ -16,7 +16,7 @@
 #include <sstream>
 #include <variant>
 
-#include "sheardiff/io/text.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/scene/registry.hpp"
 
 namespace sheardiff {

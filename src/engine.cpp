@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/scene/registry.hpp"
 #include "sheardiff/setup/random_packing.hpp"
@@ -98,7 +99,8 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   const double range = interaction_range_factor(cfg);
   ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);
-  if (scene.fluid) fb.set_fluid(std::move(*scene.fluid));
+  if (const auto& g = scene.fluid)
+    fb.set_fluid(FluidLayer(g->y_lo, g->y_hi, g->cells, g->lx, g->lz, g->reach));
   dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
                                          std::move(fb), NeighbourList(range, cfg.neighbour.skin),
                                          lim, std::move(scene.walls));

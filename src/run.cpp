@@ -18,6 +18,7 @@
 #include <map>
 #include <sstream>
 
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
@@ -26,7 +27,6 @@
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
 #include "sheardiff/io/run_files.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/run_extension.hpp"

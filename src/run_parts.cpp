@@ -6,11 +6,11 @@
 #include <cstdio>
 #include <utility>
 
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/summary_keys.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/channel.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"

@@ -11,6 +11,8 @@ writes). Per group (ktilde, N, ...):
   * the diagnostics of the candidate causes of docs/results.md, and the cost per run.
 
     /usr/bin/python3 tools/results_table.py DIR
+    /usr/bin/python3 tools/results_table.py --laws DIR     # only the laws table (one group)
+    /usr/bin/python3 tools/results_table.py --every-j DIR  # only every J against the seed's laws
 
 With --compare, single runs against a reference run (the checks of docs/results.md: one seed of
 another N, ktilde, mixing rule, ... against a point of the same seed): each quantity with the
@@ -54,8 +56,9 @@ def verdict(x, e, ref, ref_e):
 def law(f):
     if "error" in f:
         return f"not fitted ({f['error']})"
+    e = f.get("b_stderr")
     return f"{pm(f['a'], f.get('a_stderr'))}, {f['b']:+.3f}" + (
-        f" +- {f['b_stderr']:.3f}" if f.get("b_stderr") is not None else "")
+        "" if e is None else f" +- {e:.3f}" if e >= 0.001 else f" +- {e:.1g}")
 
 
 # Quantities of a run compared by --compare: summary key, its error key (None: no error bar).
@@ -98,8 +101,11 @@ def main():
             sys.exit(f"usage: {sys.argv[0]} --compare REF_POINT POINT [POINT ...]")
         compare(sys.argv[2:])
         return
+    only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in ("--laws", "--every-j") else None
+    if only:
+        del sys.argv[1]
     if len(sys.argv) != 2:
-        sys.exit(f"usage: {sys.argv[0]} DIR (a sweep folder or results/<name>)")
+        sys.exit(f"usage: {sys.argv[0]} [--laws | --every-j] DIR (a sweep folder or results/<name>)")
     out = pathlib.Path(sys.argv[1])
     if not out.is_dir():
         sys.exit(f"{out}: not a directory")
@@ -112,6 +118,12 @@ def main():
         sys.exit(f"{out}: fits.json has no J fits (a sweep without a flow.J axis, such as "
                  f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
+    if only:
+        if len(fits["groups"]) != 1:
+            sys.exit(f"{out}: {only} needs one group of points, not {len(fits['groups'])}")
+        g = fits["groups"][0]
+        law_table(g["fits"], seed) if only == "--laws" else against_seed_laws(g["rows"], False)
+        return
     # Measurements that enter the fits; every finished run counts for the cost.
     # (`sheardiff fit --include-not-stationary` fits the flagged windows too: so does this.)
     flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
@@ -136,33 +148,8 @@ def main():
                     c += f" [{r[q + '_run_err']:.2g}]"
                 cells.append(c)
             print(f"| {r['J']:g} | {r['runs']} | " + " | ".join(cells) + " |")
-        f = g["fits"]
-        print("\n| law | sheardiff: a, b (seed-bootstrap errors) | seed Table 1: a, b | a | b |")
-        print("|---|---|---|---|---|")
-        for key, name in (("D_vs_J", "D/(gammadot d^2) = a J^b"),
-                          ("dv_vs_J", "dv/(gammadot d) = a J^b"),
-                          ("psi_vs_J", "Psi gammadot = a J^b"),
-                          ("D_vs_phic_minus_phi", "D/(gammadot d^2) = a (phi_c - phi)^b"),
-                          ("dv_vs_phic_minus_phi", "dv/(gammadot d) = a (phi_c - phi)^b"),
-                          ("psi_vs_phic_minus_phi", "Psi gammadot = a (phi_c - phi)^b")):
-            s, ff = seed[key], f[key]
-            va = verdict(ff.get("a"), ff.get("a_stderr"), s["a"], s["a_stderr"]) if "a" in ff else "-"
-            vb = verdict(ff.get("b"), ff.get("b_stderr"), s["b"], s["b_stderr"]) if "b" in ff else "-"
-            print(f"| {name} | {law(ff)} | {s['a']} +- {s['a_stderr']}, {s['b']} +- "
-                  f"{s['b_stderr']} | {va} | {vb} |")
-        p = f["phi_of_J"]
-        if "phi_c" in p:
-            warn = " (above the 2D close packing 0.9069: unphysical)" if p["phi_c"] > 0.9069 else ""
-            print(f"| phi = phi_c - a J^b | phi_c = {pm(p['phi_c'], p.get('phi_c_stderr'), 4)}"
-                  f"{warn}, a = {pm(p['a'], p.get('a_stderr'))}, b = {pm(p['b'], p.get('b_stderr'))} "
-                  f"| phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5 | phi_c: "
-                  f"{verdict(p['phi_c'], p.get('phi_c_stderr'), 0.81, 0.01)} | "
-                  f"{verdict(p['b'], p.get('b_stderr'), 0.5, 0.0)} |")
-        m = f["mu_of_J"]
-        if "mu_c" in m:
-            print(f"| mu = mu_c + a J^b | mu_c = {pm(m['mu_c'], m.get('mu_c_stderr'))}, "
-                  f"a = {pm(m['a'], m.get('a_stderr'))}, b = {pm(m['b'], m.get('b_stderr'))} "
-                  f"| - | - | - |")
+        print()
+        law_table(g["fits"], seed)
         print()
         against_seed_laws(g["rows"])
     causes(done)
@@ -171,17 +158,50 @@ def main():
         subrange_fits(done)
 
 
+def law_table(f, seed):
+    """The fitted laws of one group against the seed's Table 1, with verdicts."""
+    print("| law | sheardiff: a, b (seed-bootstrap errors) | seed Table 1: a, b | a | b |")
+    print("|---|---|---|---|---|")
+    for key, name in (("D_vs_J", "D/(gammadot d^2) = a J^b"),
+                      ("dv_vs_J", "dv/(gammadot d) = a J^b"),
+                      ("psi_vs_J", "Psi gammadot = a J^b"),
+                      ("D_vs_phic_minus_phi", "D/(gammadot d^2) = a (phi_c - phi)^b"),
+                      ("dv_vs_phic_minus_phi", "dv/(gammadot d) = a (phi_c - phi)^b"),
+                      ("psi_vs_phic_minus_phi", "Psi gammadot = a (phi_c - phi)^b")):
+        s, ff = seed[key], f[key]
+        va = verdict(ff.get("a"), ff.get("a_stderr"), s["a"], s["a_stderr"]) if "a" in ff else "-"
+        vb = verdict(ff.get("b"), ff.get("b_stderr"), s["b"], s["b_stderr"]) if "b" in ff else "-"
+        print(f"| {name} | {law(ff)} | {s['a']} +- {s['a_stderr']}, {s['b']} +- "
+              f"{s['b_stderr']} | {va} | {vb} |")
+    p = f["phi_of_J"]
+    if "phi_c" in p:
+        e = p.get("phi_c_stderr")
+        phi_c = f"{p['phi_c']:.4f}" + ("" if e is None else f" +- {e:.4f}")
+        warn = " (above the 2D close packing 0.9069: unphysical)" if p["phi_c"] > 0.9069 else ""
+        print(f"| phi = phi_c - a J^b | phi_c = {phi_c}"
+              f"{warn}, a = {pm(p['a'], p.get('a_stderr'))}, b = {pm(p['b'], p.get('b_stderr'))} "
+              f"| phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5 | phi_c: "
+              f"{verdict(p['phi_c'], p.get('phi_c_stderr'), 0.81, 0.01)} | "
+              f"{verdict(p['b'], p.get('b_stderr'), 0.5, 0.0)} |")
+    m = f["mu_of_J"]
+    if "mu_c" in m:
+        print(f"| mu = mu_c + a J^b | mu_c = {pm(m['mu_c'], m.get('mu_c_stderr'))}, "
+              f"a = {pm(m['a'], m.get('a_stderr'))}, b = {pm(m['b'], m.get('b_stderr'))} "
+              f"| - | - | - |")
+
+
 # The seed's laws (its Table 1 and eq. 3.3), evaluated at each of our J.
 SEED_LAWS = {"phi": lambda J: 0.81 - 0.64 * math.sqrt(J), "D": lambda J: 0.024 * J ** -0.26,
              "dv": lambda J: 0.258 * J ** -0.25, "psi": lambda J: 0.35 * J ** 0.24}
 
 
-def against_seed_laws(rows):
+def against_seed_laws(rows, heading=True):
     """Per J: ours (mean over seeds +- sem), the seed's law there, and ours over the seed's."""
-    print("#### Every J against the seed's laws\n")
-    print("Ours: mean over seeds +- standard error from their scatter; seed: its Table 1 law "
-          "(phi: eq. 3.3, 0.81 - 0.64 J^1/2) at the same J; ratio: ours / seed's (phi: the "
-          "difference).\n")
+    if heading:
+        print("#### Every J against the seed's laws\n")
+        print("Ours: mean over seeds +- standard error from their scatter; seed: its Table 1 law "
+              "(phi: eq. 3.3, 0.81 - 0.64 J^1/2) at the same J; ratio: ours / seed's (phi: the "
+              "difference).\n")
     print("| J | phi | seed | ours - seed | D | seed | ratio | dv | seed | ratio | Psi | seed | "
           "ratio |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "sheardiff/interactions/stokes_drag.hpp"
-#include "sheardiff/solver/resistance_system.hpp"
 
 namespace sheardiff {
 
@@ -48,7 +47,7 @@ std::vector<std::pair<int, int>> FluidLayer::pattern(const std::vector<double>& 
 }
 
 void FluidLayer::assemble(const Particles& p, const ImposedFlow& reference, int dof, int base,
-                          ResistanceSystem& system) const {
+                          SystemEntries& system) const {
   // Viscous dissipation (1/2) eta lz lx int w'^2 dy of the deviation: the stiffness of linear
   // elements; the cross term with U_ref' integrates by parts (w = 0 at the walls) to
   // eta lz lx U_ref'' int phi_k dy = -G0 e_k on the right-hand side.

@@ -46,4 +46,31 @@ Mat6 PairResistance::matrix(const Vec2& n, const Vec2& t) const {
   return m;
 }
 
+Mat12 PairResistance::matrix_3d(const Space3& n) const {
+  const Mat3 nn = n * n.transpose();
+  const Mat3 plane = Mat3::Identity() - nn;  // onto the plane normal to n
+  const Mat3 a = xa * nn + ya * plane;
+  // The torque on i is -beta_i n x (u_i - u_j), the force on i from the spins
+  // beta_i omega_i x n = -beta_i (n x omega_i): in 2D, beta_i omega_i t with t = z x n.
+  const Mat3 nx = cross_matrix(n);
+  Mat12 m;
+  m.block<3, 3>(0, 0) = a;
+  m.block<3, 3>(0, 3) = -beta_i * nx;
+  m.block<3, 3>(0, 6) = -a;
+  m.block<3, 3>(0, 9) = -beta_j * nx;
+  m.block<3, 3>(3, 0) = beta_i * nx;
+  m.block<3, 3>(3, 3) = gam_ii * plane;
+  m.block<3, 3>(3, 6) = -beta_i * nx;
+  m.block<3, 3>(3, 9) = gam_ij * plane;
+  m.block<3, 3>(6, 0) = -a;
+  m.block<3, 3>(6, 3) = beta_i * nx;
+  m.block<3, 3>(6, 6) = a;
+  m.block<3, 3>(6, 9) = beta_j * nx;
+  m.block<3, 3>(9, 0) = beta_j * nx;
+  m.block<3, 3>(9, 3) = gam_ij * plane;
+  m.block<3, 3>(9, 6) = -beta_j * nx;
+  m.block<3, 3>(9, 9) = gam_jj * plane;
+  return m;
+}
+
 }  // namespace sheardiff

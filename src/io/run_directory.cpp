@@ -22,10 +22,10 @@
 #include <thread>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_files.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {

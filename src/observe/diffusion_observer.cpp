@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "sheardiff/core/output_schedule.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/run_files.hpp"
 #include "sheardiff/io/summary_keys.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/observe/analysis_file.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/scene/scene.hpp"

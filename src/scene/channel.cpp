@@ -116,8 +116,8 @@ Scene build_channel(const Config& cfg) {
     const auto cells = ch.fluid_cells > 0
                            ? ch.fluid_cells
                            : std::max<std::int64_t>(4, std::llround(2.0 * ch.h_over_a));
-    sc.fluid.emplace(y_lo, y_hi, static_cast<int>(cells), lx, cfg.flow.lz,
-                     0.5 * cfg.neighbour.skin);
+    sc.fluid =
+        FluidGrid{y_lo, y_hi, static_cast<int>(cells), lx, cfg.flow.lz, 0.5 * cfg.neighbour.skin};
   }
   return sc;
 }

@@ -12,9 +12,9 @@
 
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/summary_keys.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {

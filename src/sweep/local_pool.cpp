@@ -18,10 +18,10 @@
 #include <optional>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_directory.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/run.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 

@@ -17,10 +17,10 @@
 #include <thread>
 
 #include "sheardiff/core/archive.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/run_directory.hpp"
-#include "sheardiff/io/text.hpp"
 #include "sheardiff/run.hpp"
 #include "sheardiff/version.hpp"
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "sheardiff/config.hpp"
-#include "sheardiff/io/text.hpp"
+#include "sheardiff/core/text.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/pair_history.hpp"
 #include "sheardiff/interactions/pair_law.hpp"
 
 namespace sheardiff {
@@ -13,10 +14,7 @@ namespace sheardiff {
 struct FrictionalContact {
   // State a contact carries from step to step (whether the pair touches is the pair's own,
   // PairHistory::touching).
-  struct History {
-    double xi = 0.0;       // scalar tangential spring stretch (2D)
-    bool sliding = false;  // the last step capped xi at the Coulomb limit
-  };
+  using History = TangentialSpring;  // core/pair_history.hpp
 
   double kn = 1e4;
   double kt = 5e3;
@@ -32,7 +30,10 @@ struct FrictionalContact {
   }
 
   bool has_friction() const { return mu > 0.0 && kt > 0.0; }
-  double scale(const PairGeometry& g) const { return scale_with_radius ? g.ai + g.aj : 1.0; }
+  template <class Geometry>  // PairGeometry or PairGeometry3
+  double scale(const Geometry& g) const {
+    return scale_with_radius ? g.ai + g.aj : 1.0;
+  }
   double kn_of(const PairGeometry& g) const { return kn * scale(g); }
   double kt_of(const PairGeometry& g) const { return kt * scale(g); }
 
@@ -107,6 +108,69 @@ struct FrictionalContact {
     h.sliding = false;
     return true;
   }
+  // ---- Three dimensions (spheres; the law's vector form, not yet driven by the engine) ----
+  // The tangential spring is a vector xi in the plane normal to n; in a pair of the x-y plane it
+  // is the disc's xi times t = z x n. Pair space: (u, omega)_i, (u, omega)_j.
+  using Vec12 = Eigen::Matrix<double, 12, 1>;
+  using SlipMode3 = Eigen::Matrix<double, 3, 12>;
+  static Vec12 normal_mode_3d(const PairGeometry3& g) {
+    Vec12 m = Vec12::Zero();
+    m.segment<3>(0) = g.n;
+    m.segment<3>(6) = -g.n;
+    return m;
+  }
+  // Slip velocity v_s = -W U = (I - n n^T)(u_j - u_i) - (a_i omega_i + a_j omega_j) x n.
+  static SlipMode3 slip_mode_3d(const PairGeometry3& g) {
+    const Mat3 plane = Mat3::Identity() - g.n * g.n.transpose();
+    const Mat3 nx = cross_matrix(g.n);
+    SlipMode3 w;
+    w << plane, -g.ai * nx, -plane, -g.aj * nx;
+    return w;
+  }
+  static Space3 slip_velocity_3d(const PairGeometry3& g, const Vec12& u) {
+    return -slip_mode_3d(g) * u;
+  }
+  // Spring force and torque on the pair: the normal spring and kt xi on i (-kt xi on j), whose
+  // torques are a n x kt xi on both spheres.
+  Vec12 spring_force_3d(const PairGeometry3& g, const Space3& xi) const {
+    return scale(g) *
+           (-kn * g.overlap() * normal_mode_3d(g) + kt * slip_mode_3d(g).transpose() * xi);
+  }
+  Mat12 stiffness_3d(const PairGeometry3& g, bool sliding) const {
+    const Vec12 m = normal_mode_3d(g);
+    Mat12 k = kn * m * m.transpose();
+    if (has_friction() && !sliding) {
+      const SlipMode3 w = slip_mode_3d(g);
+      k += kt * w.transpose() * w;
+    }
+    return scale(g) * k;
+  }
+  // The spring stretches with the slip, then turns with the pair: it is brought back into the
+  // plane normal to the new n with its length kept (what rotates with the contact).
+  static void advance_3d(Space3& xi, const PairGeometry3& g, const Vec12& u, double dt) {
+    xi += slip_velocity_3d(g, u) * dt;
+  }
+  static void turn_with_pair(Space3& xi, const Space3& n) {
+    const double length = xi.norm();
+    const Space3 in_plane = xi - n.dot(xi) * n;
+    const double l = in_plane.norm();
+    xi = l > 0.0 ? Space3(in_plane * (length / l)) : Space3::Zero();
+  }
+  // Coulomb: |kt xi| <= mu kn overlap, the spring shortened along itself; returns whether it
+  // slides.
+  bool apply_coulomb_3d(const PairGeometry3& g, Space3& xi) const {
+    if (!has_friction()) {
+      xi.setZero();
+      return false;
+    }
+    const double cap = mu * kn * std::max(g.overlap(), 0.0) / kt, length = xi.norm();
+    if (length > cap) {
+      xi *= cap / length;
+      return true;
+    }
+    return false;
+  }
+
   void add_stability(double, StabilityTerms& s) const {
     s.normal_stiffness += kn;
     if (has_friction()) s.tangential_stiffness += kt;

@@ -19,10 +19,9 @@
 #include "sheardiff/core/imposed_flow.hpp"
 #include "sheardiff/core/particles.hpp"
 #include "sheardiff/core/types.hpp"
+#include "sheardiff/interactions/system_entries.hpp"
 
 namespace sheardiff {
-
-class ResistanceSystem;
 
 class FluidLayer {
  public:
@@ -45,7 +44,7 @@ class FluidLayer {
   // Adds the layer's blocks and right-hand side (the particles' drag on the fluid against the
   // reference flow, the fluid's viscous term and the reference profile's pressure gradient G0).
   void assemble(const Particles& p, const ImposedFlow& reference, int dof, int base,
-                ResistanceSystem& system) const;
+                SystemEntries& system) const;
   // The pressure gradient's generalised force on the fluid unknowns (per unit G): e_k =
   // Lx lz int phi_k dy; e . w = Lx lz int w dy, the deviation's flux.
   VecX load(std::size_t total_unknowns, int base) const;

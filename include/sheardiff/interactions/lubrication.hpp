@@ -15,6 +15,11 @@ struct PairResistance {
   // The 6x6 block R_pair in the order (u_x, u_y, omega)_i, (u_x, u_y, omega)_j
   // (docs/model.md section 4); the pair's force and torque are -R_pair U.
   Mat6 matrix(const Vec2& n, const Vec2& t) const;
+  // The same law between two spheres in three dimensions, in its vector form (Mari et al. 2014):
+  // the 12x12 block in the order (u, omega)_i, (u, omega)_j, with A = XA n n^T + YA (I - n n^T),
+  // the shear-rotation coupling through n x . and the rotational modes on the plane normal to
+  // n. Restricted to (u_x, u_y, omega_z) of a pair in the x-y plane it is matrix(n, z x n).
+  Mat12 matrix_3d(const Space3& n) const;
 };
 
 // Leading singular lubrication between two discs of a monolayer (Ball & Melrose modes),

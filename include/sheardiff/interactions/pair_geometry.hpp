@@ -29,4 +29,26 @@ struct PairGeometry {
   }
 };
 
+// The same for two spheres in three dimensions (no t: the tangent plane is normal to n).
+struct PairGeometry3 {
+  double ai = 0.5, aj = 0.5;
+  double s = 1.0;
+  double r = 1.0;
+  double h = 0.0;
+  Space3 n = Space3::UnitX();
+
+  double overlap() const { return s - r; }
+
+  static PairGeometry3 make(const Space3& rij, double ai, double aj) {
+    PairGeometry3 g;
+    g.ai = ai;
+    g.aj = aj;
+    g.s = ai + aj;
+    g.r = rij.norm();
+    g.n = rij / g.r;
+    g.h = 2.0 * g.r / g.s - 2.0;
+    return g;
+  }
+};
+
 }  // namespace sheardiff

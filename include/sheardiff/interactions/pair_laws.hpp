@@ -2,13 +2,14 @@
 // The pair laws of the engine and the generic operations over them (pair_law.hpp has the
 // contract). A new law is its header and its parameters header (NAME_params.hpp: its keys,
 // declared once), one member of Config, one declare_section line and one entry in PairLaws below
-// (and, if it keeps a per-contact history, one member of PairHistory).
+// (and, if it keeps a per-contact history, one member of PairHistory, core/pair_history.hpp).
 #include <algorithm>
 #include <optional>
 #include <tuple>
 #include <type_traits>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/pair_history.hpp"
 #include "sheardiff/interactions/contact.hpp"
 #include "sheardiff/interactions/lubrication.hpp"
 #include "sheardiff/interactions/pair_law.hpp"
@@ -16,25 +17,17 @@
 
 namespace sheardiff {
 
-// What one listed pair carries from step to step: whether it touches (decided at the start of a
-// step, shared by every law) and the history of each law that keeps one. Trivially copyable: it
-// is checkpointed as raw bytes with the neighbour list.
-struct PairHistory {
-  bool touching = false;
-  FrictionalContact::History contact;
-};
-
 // The history of law L inside a pair's record.
 template <class L>
 decltype(auto) history_of(PairHistory& h) {
-  if constexpr (std::is_same_v<typename L::History, FrictionalContact::History>)
+  if constexpr (std::is_same_v<typename L::History, TangentialSpring>)
     return (h.contact);
   else
     return typename L::History{};
 }
 template <class L>
 decltype(auto) history_of(const PairHistory& h) {
-  if constexpr (std::is_same_v<typename L::History, FrictionalContact::History>)
+  if constexpr (std::is_same_v<typename L::History, TangentialSpring>)
     return (h.contact);
   else
     return typename L::History{};

@@ -4,14 +4,14 @@
 
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/box.hpp"
+#include "sheardiff/core/pair_history.hpp"
 #include "sheardiff/core/particles.hpp"
-#include "sheardiff/interactions/pair_laws.hpp"
 
 namespace sheardiff {
 
 // One listed pair. i is always mobile; j is mobile or a wall particle. j is seen through the
 // periodic image (kx, ky) of the box. Wall-wall pairs are never listed. history: what the pair
-// laws keep for it from step to step (pair_laws.hpp), carried while the pair touches.
+// laws keep for it from step to step (core/pair_history.hpp), carried while the pair touches.
 struct Pair {
   int i = 0, j = 0;
   int kx = 0, ky = 0;

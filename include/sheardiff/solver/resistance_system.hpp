@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sheardiff/core/particles.hpp"
+#include "sheardiff/interactions/system_entries.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
 #include "sheardiff/solver/sparse_cholesky.hpp"
 
@@ -20,7 +21,7 @@ namespace sheardiff {
 // optional y velocity V of one floating wall, eliminated by two back-solves on one factor.
 // The sparsity pattern (and the symbolic factorisation) are rebuilt only with the neighbour
 // list: pairs out of range keep their structural zeros.
-class ResistanceSystem {
+class ResistanceSystem final : public SystemEntries {
  public:
   explicit ResistanceSystem(int dof = 3, const std::string& cholesky = "cholmod")
       : dof_(dof), llt_(make_sparse_cholesky(cholesky)) {}
@@ -47,8 +48,8 @@ class ResistanceSystem {
                 bool j_mobile, bool j_floating);
 
   // One entry of the matrix (row >= col, in the pattern) and of the right-hand side.
-  void add_value(int row, int col, double v);
-  void add_rhs(int row, double v) { g_[row] += v; }
+  void add_value(int row, int col, double v) override;
+  void add_rhs(int row, double v) override { g_[row] += v; }
 
   // Solve. With a floating wall, its y force balance reads b.U + c V = wall_rhs - load.
   // Returns false if the factorisation failed (matrix not positive definite).

@@ -1,4 +1,4 @@
-#include "sheardiff/io/text.hpp"
+#include "sheardiff/core/text.hpp"
 
 #include <fmt/format.h>
 #include <unistd.h>

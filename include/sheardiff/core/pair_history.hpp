@@ -1,0 +1,22 @@
+#pragma once
+// What one listed pair carries from step to step, as state (the neighbour list keeps it, the
+// pair laws read and advance it; interactions/pair_laws.hpp maps each law to its member). A law
+// that keeps a per-contact history adds one member here.
+
+namespace sheardiff {
+
+// The tangential spring of a frictional contact (interactions/contact.hpp is its law).
+struct TangentialSpring {
+  double xi = 0.0;       // scalar tangential spring stretch (2D)
+  bool sliding = false;  // the last step capped xi at the Coulomb limit
+};
+
+// Whether the pair touches (decided at the start of a step, shared by every law) and the
+// history of each law that keeps one. Trivially copyable: it is checkpointed as raw bytes with
+// the neighbour list.
+struct PairHistory {
+  bool touching = false;
+  TangentialSpring contact;
+};
+
+}  // namespace sheardiff
