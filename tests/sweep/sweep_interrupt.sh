@@ -6,6 +6,9 @@
 set -euo pipefail
 bin=$(realpath "$1"); repo=$(realpath "$2"); work=$3
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
+# A failure names its line and shows what the sweeps printed (it once failed under a loaded
+# machine with nothing to read).
+trap 'rc=$?; echo "FAILED (exit $rc) at line $LINENO"; for f in first concurrent collect second; do [ -f $f.log ] && { echo "--- $f.log"; tail -n 15 $f.log; }; done; ls out/points 2>/dev/null' ERR
 cat > tiny.toml <<TOML
 [sweep]
 base = "$repo/configs/quick.toml"
