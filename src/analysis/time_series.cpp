@@ -25,15 +25,16 @@ void check_series(const char* who, const Eigen::MatrixXd& y, double dt, long max
     throw std::invalid_argument(fmt::format("{}: dt = {} must be positive and finite", who, dt));
   }
   if (max_lag < 0 || max_lag >= y.rows()) {
-    throw std::invalid_argument(fmt::format("{}: max_lag = {} must be in [0, frames - 1 = {}]",
-                                            who, max_lag, y.rows() - 1));
+    throw std::invalid_argument(fmt::format("{}: max_lag = {} must be in [0, frames - 1 = {}]", who,
+                                            max_lag, y.rows() - 1));
   }
   if (!y.allFinite()) throw std::invalid_argument(fmt::format("{}: non-finite samples", who));
 }
 
 std::vector<double> lag_times(double dt, long max_lag) {
   std::vector<double> lag(static_cast<std::size_t>(max_lag) + 1);
-  for (long k = 0; k <= max_lag; ++k) lag[static_cast<std::size_t>(k)] = static_cast<double>(k) * dt;
+  for (long k = 0; k <= max_lag; ++k)
+    lag[static_cast<std::size_t>(k)] = static_cast<double>(k) * dt;
   return lag;
 }
 
@@ -127,9 +128,9 @@ MsdResult mean_square_displacement(const Eigen::MatrixXd& y, double dt, long max
   const long frames = static_cast<long>(y.rows());
   for (long t0 : reference_frames) {
     if (t0 < 0 || t0 + max_lag >= frames) {
-      throw std::invalid_argument(fmt::format(
-          "mean_square_displacement: reference frame {} with max_lag {} leaves [0, {})", t0,
-          max_lag, frames));
+      throw std::invalid_argument(
+          fmt::format("mean_square_displacement: reference frame {} with max_lag {} leaves [0, {})",
+                      t0, max_lag, frames));
     }
   }
   // Frames as contiguous columns so each lag is one vectorised difference over particles.
@@ -154,15 +155,14 @@ MsdResult mean_square_displacement(const Eigen::MatrixXd& y, double dt, long max
 std::vector<long> draw_reference_frames(long first, long last_exclusive, long max_lag, long n,
                                         std::uint64_t seed) {
   if (first < 0 || max_lag < 0 || n < 1) {
-    throw std::invalid_argument(fmt::format(
-        "draw_reference_frames: need first >= 0, max_lag >= 0, n >= 1 (got {}, {}, {})", first,
-        max_lag, n));
+    throw std::invalid_argument(
+        fmt::format("draw_reference_frames: need first >= 0, max_lag >= 0, n >= 1 (got {}, {}, {})",
+                    first, max_lag, n));
   }
   const long available = last_exclusive - max_lag - first;
   if (available < 1) {
-    throw std::invalid_argument(
-        fmt::format("draw_reference_frames: empty range [{}, {} - {})", first, last_exclusive,
-                    max_lag));
+    throw std::invalid_argument(fmt::format("draw_reference_frames: empty range [{}, {} - {})",
+                                            first, last_exclusive, max_lag));
   }
   std::mt19937_64 rng(seed);
   std::vector<long> out;
@@ -177,9 +177,9 @@ std::vector<long> draw_reference_frames(long first, long last_exclusive, long ma
     std::vector<long> pool(static_cast<std::size_t>(available));
     std::iota(pool.begin(), pool.end(), first);
     for (long i = 0; i < extra; ++i) {
-      const auto j = static_cast<long>(
-          static_cast<std::uint64_t>(i) +
-          uniform_below(rng, static_cast<std::uint64_t>(available - i)));
+      const auto j =
+          static_cast<long>(static_cast<std::uint64_t>(i) +
+                            uniform_below(rng, static_cast<std::uint64_t>(available - i)));
       std::swap(pool[static_cast<std::size_t>(i)], pool[static_cast<std::size_t>(j)]);
       out.push_back(pool[static_cast<std::size_t>(i)]);
     }
@@ -205,9 +205,9 @@ Autocorrelation velocity_autocorrelation(const Eigen::MatrixXd& v, double dt, lo
 
 Persistence persistence_time(const Autocorrelation& ac) {
   if (ac.lag.size() != ac.c.size() || ac.c.size() < 2) {
-    throw std::invalid_argument(fmt::format(
-        "persistence_time: need matching lag/c of at least 2 values (got {} and {})",
-        ac.lag.size(), ac.c.size()));
+    throw std::invalid_argument(
+        fmt::format("persistence_time: need matching lag/c of at least 2 values (got {} and {})",
+                    ac.lag.size(), ac.c.size()));
   }
   for (std::size_t i = 0; i < ac.c.size(); ++i) {
     if (!std::isfinite(ac.c[i]) || !std::isfinite(ac.lag[i])) {
@@ -250,8 +250,8 @@ Persistence persistence_time(const Autocorrelation& ac) {
 
 DiffusionFit fit_diffusion(const MsdResult& msd, double t_lo, double t_hi) {
   if (msd.lag.size() != msd.msd.size()) {
-    throw std::invalid_argument(fmt::format("fit_diffusion: {} lags but {} msd values",
-                                            msd.lag.size(), msd.msd.size()));
+    throw std::invalid_argument(
+        fmt::format("fit_diffusion: {} lags but {} msd values", msd.lag.size(), msd.msd.size()));
   }
   if (!(t_lo < t_hi) || !std::isfinite(t_lo) || !std::isfinite(t_hi)) {
     throw std::invalid_argument(
@@ -280,8 +280,8 @@ DiffusionFit fit_diffusion(const MsdResult& msd, double t_lo, double t_hi) {
   out.d_stderr = 0.5 * line.slope_stderr;
   out.intercept = line.intercept;
   out.points = line.n;
-  out.loglog_slope = logt.size() >= 3 ? fit_line(logt, logm).slope
-                                      : std::numeric_limits<double>::quiet_NaN();
+  out.loglog_slope =
+      logt.size() >= 3 ? fit_line(logt, logm).slope : std::numeric_limits<double>::quiet_NaN();
   return out;
 }
 

@@ -27,15 +27,15 @@ double jackknife_err(const std::vector<double>& x) {
   return std::sqrt((n - 1.0) / n * s);
 }
 
-
 BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& x, double t_from,
                        double t_to, long blocks) {
   if (t.size() != x.size())
     throw std::invalid_argument(
         fmt::format("batch_means: {} times but {} samples", t.size(), x.size()));
   if (blocks < 1 || !(t_to > t_from))
-    throw std::invalid_argument(fmt::format(
-        "batch_means: need blocks >= 1 and t_to > t_from (got {}, [{}, {}])", blocks, t_from, t_to));
+    throw std::invalid_argument(
+        fmt::format("batch_means: need blocks >= 1 and t_to > t_from (got {}, [{}, {}])", blocks,
+                    t_from, t_to));
   BatchMeans out;
   std::vector<double> sum(static_cast<std::size_t>(blocks), 0.0);
   std::vector<long> count(static_cast<std::size_t>(blocks), 0);
@@ -80,8 +80,7 @@ MsdSlopeError slope_error_from_gram(const Eigen::MatrixXd& gram, long increments
   out.blocks = increments / block_frames;
   if (out.blocks < 2)
     throw std::invalid_argument(fmt::format(
-        "msd_slope_error: {} increments make fewer than 2 blocks of {}", increments,
-        block_frames));
+        "msd_slope_error: {} increments make fewer than 2 blocks of {}", increments, block_frames));
   // Whole blocks only: the estimate is that of the first blocks * block_frames increments.
   const long n = out.blocks * block_frames;
   const long frames = n + 1;
@@ -94,9 +93,9 @@ MsdSlopeError slope_error_from_gram(const Eigen::MatrixXd& gram, long increments
        L <= std::min(frames - 1, static_cast<long>(std::floor(hi / dt + tol))); ++L)
     lags.push_back(L);
   if (lags.size() < 3)
-    throw std::invalid_argument(fmt::format(
-        "msd_slope_error: the window [{}, {}] holds {} lags of {} frames, need 3", lo, hi,
-        lags.size(), frames));
+    throw std::invalid_argument(
+        fmt::format("msd_slope_error: the window [{}, {}] holds {} lags of {} frames, need 3", lo,
+                    hi, lags.size(), frames));
   double tbar = 0;
   for (long L : lags) tbar += static_cast<double>(L) * dt / static_cast<double>(lags.size());
   double sxx = 0;
@@ -161,8 +160,8 @@ MsdSlopeError msd_slope_error(const Eigen::MatrixXd& y, double dt, double lo, do
   const long increments = static_cast<long>(y.rows()) - 1;
   const long n = std::max(0L, increments / block_frames * block_frames);
   const Eigen::MatrixXd inc = y.middleRows(1, n) - y.topRows(n);
-  return slope_error_from_gram(inc * inc.transpose(), increments, static_cast<double>(y.cols()),
-                               dt, lo, hi, block_frames);
+  return slope_error_from_gram(inc * inc.transpose(), increments, static_cast<double>(y.cols()), dt,
+                               lo, hi, block_frames);
 }
 
 IncrementGram::IncrementGram(long width, long band) : width_(width), band_(band) {
@@ -216,16 +215,16 @@ Eigen::MatrixXd IncrementGram::gram(long increments) const {
 
 MsdResult IncrementGram::msd(double dt, long max_lag) const {
   if (max_lag > band_ || max_lag >= samples_)
-    throw std::invalid_argument(fmt::format(
-        "IncrementGram::msd: lag {} beyond the band {} or the {} samples", max_lag, band_,
-        samples_));
+    throw std::invalid_argument(
+        fmt::format("IncrementGram::msd: lag {} beyond the band {} or the {} samples", max_lag,
+                    band_, samples_));
   MsdResult out;
   for (long k = 0; k <= max_lag; ++k) {
     const long pairs = width_ * (samples_ - k);
     out.lag.push_back(static_cast<double>(k) * dt);
     out.samples.push_back(pairs);
-    out.msd.push_back(k == 0 ? 0.0 : msd_sum_[static_cast<std::size_t>(k)] /
-                                         static_cast<double>(pairs));
+    out.msd.push_back(k == 0 ? 0.0
+                             : msd_sum_[static_cast<std::size_t>(k)] / static_cast<double>(pairs));
   }
   return out;
 }
@@ -334,9 +333,9 @@ MsdResult masked_mean_square_displacement(const Eigen::MatrixXd& y, const Eigen:
   if (mask.rows() != y.rows() || mask.cols() != y.cols())
     throw std::invalid_argument("masked_mean_square_displacement: mask shape differs from y");
   if (max_lag < 1 || max_lag >= frames || reference_frames.empty())
-    throw std::invalid_argument(fmt::format(
-        "masked_mean_square_displacement: max_lag {} of {} frames, {} reference frames", max_lag,
-        frames, reference_frames.size()));
+    throw std::invalid_argument(
+        fmt::format("masked_mean_square_displacement: max_lag {} of {} frames, {} reference frames",
+                    max_lag, frames, reference_frames.size()));
   const Eigen::MatrixXd by_frame = y.transpose();
   const Eigen::MatrixXd m = mask.transpose();
   std::vector<double> acc(static_cast<std::size_t>(max_lag) + 1, 0.0);
@@ -344,14 +343,13 @@ MsdResult masked_mean_square_displacement(const Eigen::MatrixXd& y, const Eigen:
   for (long t0 : reference_frames) {
     if (t0 < 0 || t0 + max_lag >= frames)
       throw std::invalid_argument(fmt::format(
-          "masked_mean_square_displacement: reference frame {} with max_lag {} leaves [0, {})",
-          t0, max_lag, frames));
+          "masked_mean_square_displacement: reference frame {} with max_lag {} leaves [0, {})", t0,
+          max_lag, frames));
     const auto base = by_frame.col(t0);
     const auto w = m.col(t0);
     weight += w.sum();
     for (long k = 1; k <= max_lag; ++k)
-      acc[static_cast<std::size_t>(k)] +=
-          w.dot((by_frame.col(t0 + k) - base).cwiseAbs2());
+      acc[static_cast<std::size_t>(k)] += w.dot((by_frame.col(t0 + k) - base).cwiseAbs2());
   }
   MsdResult out;
   for (long k = 0; k <= max_lag; ++k) {

@@ -855,8 +855,8 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
     const Handle fapl = latest_format(path);
     hbool_t clear = true;
     H5Pset(fapl.get(), "clear_status_flags", &clear);
-    m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path,
-                      "/", "cannot reopen the trajectory to resume it");
+    m->file = checked(H5Fopen(path.string().c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path, "/",
+                      "cannot reopen the trajectory to resume it");
   }
   const hid_t f = m->file.get();
   const auto rows = static_cast<hsize_t>(keep_frames);
@@ -1009,9 +1009,8 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   Impl& m = *impl_;
   if (m.frames_closed) throw std::logic_error("H5mdWriter: write_frame after write_table");
   const std::size_t n = m.layout.n_particles;
-  const bool want_images = m.frames == 0
-                               ? frame.image != nullptr || frame.unwrapped != nullptr
-                               : m.image.has_value();
+  const bool want_images =
+      m.frames == 0 ? frame.image != nullptr || frame.unwrapped != nullptr : m.image.has_value();
   const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
   m.check_frame(frame, want_images, want_unwrapped);
   if (m.frames == 0 && want_images) m.create_images(want_unwrapped);

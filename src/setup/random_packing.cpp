@@ -1,10 +1,10 @@
 #include "sheardiff/setup/random_packing.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 namespace sheardiff {
 
@@ -18,9 +18,14 @@ struct Grid {
   Grid(double lx_, double ly_, double cell)
       : nx(std::max(1, static_cast<int>(lx_ / cell))),
         ny(std::max(1, static_cast<int>(ly_ / cell))),
-        cx(lx_ / nx), cy(ly_ / ny), lx(lx_), ly(ly_), cells(static_cast<std::size_t>(nx) * ny) {}
+        cx(lx_ / nx),
+        cy(ly_ / ny),
+        lx(lx_),
+        ly(ly_),
+        cells(static_cast<std::size_t>(nx) * ny) {}
   int cell_of(const Vec2& x) const {
-    int ix = static_cast<int>(std::floor(x.x() / cx)), iy = static_cast<int>(std::floor(x.y() / cy));
+    int ix = static_cast<int>(std::floor(x.x() / cx)),
+        iy = static_cast<int>(std::floor(x.y() / cy));
     ix = ((ix % nx) + nx) % nx;
     iy = std::clamp(((iy % ny) + ny) % ny, 0, ny - 1);
     return iy * nx + ix;
@@ -128,8 +133,10 @@ double relax_overlaps(std::vector<Vec2>& position, const std::vector<double>& ra
       if (len > 0.1 * radius[i]) step *= 0.1 * radius[i] / len;
       position[i] += step;
       position[i].x() -= lx * std::floor(position[i].x() / lx);
-      if (periodic_y) position[i].y() -= ly * std::floor(position[i].y() / ly);
-      else position[i].y() = std::clamp(position[i].y(), radius[i], ly - radius[i]);
+      if (periodic_y)
+        position[i].y() -= ly * std::floor(position[i].y() / ly);
+      else
+        position[i].y() = std::clamp(position[i].y(), radius[i], ly - radius[i]);
     }
   }
   return worst;

@@ -55,7 +55,8 @@ std::vector<double> brute_msd(const Eigen::MatrixXd& y, long max_lag,
 
 std::vector<double> logspace(double lo, double hi, int n) {
   std::vector<double> x(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, i / (n - 1.0));
+  for (int i = 0; i < n; ++i)
+    x[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, i / (n - 1.0));
   return x;
 }
 
@@ -97,8 +98,8 @@ TEST(AnalysisMsd, BallisticIsExactQuadratic) {
   }
   const long max_lag = 100;
   const MsdResult all = mean_square_displacement(y, dt, max_lag);
-  const MsdResult some = mean_square_displacement(
-      y, dt, max_lag, draw_reference_frames(0, frames, max_lag, 50, 5));
+  const MsdResult some =
+      mean_square_displacement(y, dt, max_lag, draw_reference_frames(0, frames, max_lag, 50, 5));
   for (long k = 1; k <= max_lag; ++k) {
     const double t = static_cast<double>(k) * dt;
     EXPECT_NEAR(all.msd[static_cast<std::size_t>(k)], v2 * t * t, 1e-9 * v2 * t * t);

@@ -10,8 +10,8 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/dynamics.hpp"
-#include "sheardiff/scene/scene.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/scene/scene.hpp"
 #include "sheardiff/solver/force_balance.hpp"
 #include "sheardiff/solver/resistance_system.hpp"
 

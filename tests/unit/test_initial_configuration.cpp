@@ -6,8 +6,8 @@
 #include <fstream>
 
 #include "sheardiff/io/h5md.hpp"
-#include "sheardiff/setup/random_packing.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/setup/random_packing.hpp"
 
 namespace sheardiff {
 namespace {

@@ -11,9 +11,9 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/core/box.hpp"
 #include "sheardiff/neighbour/neighbour_list.hpp"
+#include "sheardiff/run.hpp"
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
-#include "sheardiff/run.hpp"
 
 namespace sheardiff {
 namespace {

@@ -32,7 +32,8 @@ int profile_observers(const Config& cfg) {
 TEST(ProfilesObserver, IsComposedForScenesWithWallsOnly) {
   for (const SceneKind& k : scene_registry())
     // The channel has its own profiles (observe/channel.hpp).
-    EXPECT_EQ(profile_observers(cell_config(k.name)), k.periodic_y || !k.imposes_shear_rate() ? 0 : 1)
+    EXPECT_EQ(profile_observers(cell_config(k.name)),
+              k.periodic_y || !k.imposes_shear_rate() ? 0 : 1)
         << k.name;
   Config off = cell_config("pressure_shear");
   off.observables.profiles = false;

@@ -30,8 +30,8 @@ TEST(SceneRegistry, EveryRowBuildsItsSceneAndIsAValidSceneType) {
     // The channel's disc count follows from its areal fraction, width and wall row.
     const ChannelParams ch;
     const auto n = !k.imposes_shear_rate() ? static_cast<std::size_t>(std::llround(
-                                               ch.phi * 2.0 * ch.wall_discs * ch.h_over_a / kPi))
-                                         : 60u;
+                                                 ch.phi * 2.0 * ch.wall_discs * ch.h_over_a / kPi))
+                                           : 60u;
     EXPECT_EQ(sc.particles.n_mobile, n) << k.name;
     const std::string needs = !k.imposes_shear_rate()
                                   ? "[particles]\nsize_ratio = 1.0\n[analysis]\ndiffusion = false\n"

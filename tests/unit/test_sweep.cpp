@@ -81,9 +81,10 @@ base = "base.toml"
   EXPECT_EQ(points[0].overrides[0], "analysis.velocity_intervals=[0.0035, 0.01]");
   const Config cfg = load_config(spec.base, points[0].overrides);
   EXPECT_EQ(cfg.analysis.velocity_intervals, (std::vector<double>{0.0035, 0.01}));
-  EXPECT_NE(error_of(write_files("list_bad", "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
-                                             "\"analysis.velocity_intervals\" = [\"a\"]\n"
-                                             "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
+  EXPECT_NE(error_of(write_files("list_bad",
+                                 "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
+                                 "\"analysis.velocity_intervals\" = [\"a\"]\n"
+                                 "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
                 .find("a list may only hold numbers"),
             std::string::npos);
 }

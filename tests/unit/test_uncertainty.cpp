@@ -17,8 +17,8 @@ namespace sd = sheardiff;
 
 namespace {
 
-constexpr double kDt = 0.1;       // frame spacing (strain)
-constexpr long kFrames = 301;     // 30 strains: the seed's measured window
+constexpr double kDt = 0.1;    // frame spacing (strain)
+constexpr long kFrames = 301;  // 30 strains: the seed's measured window
 constexpr long kParticles = 50;
 constexpr double kLo = 8.0, kHi = 15.0;  // the seed's MSD window
 

@@ -26,13 +26,13 @@ struct DiffusionSettings {
 // per unit strain) of every mobile disc. Times are strains, so D comes out in gammadot d^2, dv
 // in gammadot d and Psi in 1/gammadot.
 struct DiffusionReport {
-  MsdResult msd;              // every origin, lags on the correlator's multiple-tau grid
-  MsdResult msd_coarse;       // every origin on the samples coarse_strain apart: what D fits
+  MsdResult msd;         // every origin, lags on the correlator's multiple-tau grid
+  MsdResult msd_coarse;  // every origin on the samples coarse_strain apart: what D fits
   Autocorrelation vacf;
-  DiffusionFit fit;           // D: OLS over the fit window of msd_coarse, regression error
-  MsdSlopeError d_error;      // the error bar of D from the run's own time blocks
-  PersistenceEstimate vel;    // dv, Psi (every definition) and their jackknife errors
-  Persistence persistence;    // = vel.p
+  DiffusionFit fit;         // D: OLS over the fit window of msd_coarse, regression error
+  MsdSlopeError d_error;    // the error bar of D from the run's own time blocks
+  PersistenceEstimate vel;  // dv, Psi (every definition) and their jackknife errors
+  Persistence persistence;  // = vel.p
   double dv = 0.0;
   // The same analysis restricted to discs in the bulk (away from the walls) at the reference
   // time, when a bulk mask was given: bulk_fraction of the (disc, time) samples.
@@ -47,14 +47,14 @@ struct DiffusionReport {
   DiffusionFit fit_x;
   // dv and Psi of the displacement velocity (y(t + Delta) - y(t)) / Delta, per interval.
   struct IntervalVelocity {
-    double interval = 0.0;      // Delta, strain, as rounded to the grid
-    double sample_strain = 0.0; // spacing of its samples
+    double interval = 0.0;       // Delta, strain, as rounded to the grid
+    double sample_strain = 0.0;  // spacing of its samples
     PersistenceEstimate vel;
   };
   std::vector<IntervalVelocity> intervals;
-  double error_block = 0.0;   // strain, as used
-  double step_length = 0.0;   // dv Psi
-  double consistency = 0.0;   // D / (dv^2 Psi), 1 if the VACF integral carries the diffusion
+  double error_block = 0.0;  // strain, as used
+  double step_length = 0.0;  // dv Psi
+  double consistency = 0.0;  // D / (dv^2 Psi), 1 if the VACF integral carries the diffusion
   double window_lo = 0.0, window_hi = 0.0;  // the MSD window actually fitted
   double sample_strain = 0.0, coarse_strain = 0.0;
   long samples = 0, particles = 0;
@@ -64,7 +64,8 @@ struct DiffusionReport {
 // The diffusion analysis accumulated sample by sample while the run goes, so that neither the
 // trajectory nor the checkpoint has to hold the measured window (docs/model.md section 9):
 // - the VACF of v_y and the MSD of y (and of the non-affine x displacement) on a multiple-tau
-//   grid (MultipleTauCorrelator), every sample an origin, sums kept per sixteenth of an error block;
+//   grid (MultipleTauCorrelator), every sample an origin, sums kept per sixteenth of an error
+//   block;
 // - the every-origin MSD and the increment products of y on samples coarse_strain apart
 //   (IncrementGram): D and its error bar (msd_slope_error).
 // Memory is that of ~100 samples per signal (independent of the window's length) plus a few

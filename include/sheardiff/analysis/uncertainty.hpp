@@ -1,6 +1,5 @@
 #pragma once
 #include <Eigen/Core>
-
 #include <vector>
 
 #include "sheardiff/analysis/time_series.hpp"
@@ -36,8 +35,8 @@ BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& 
 // statistics). Tested for coverage on random walks, Ornstein-Uhlenbeck walks and walks with a
 // common collective mode (tests/unit/test_uncertainty.cpp).
 struct MsdSlopeError {
-  double d = 0;           // the all-reference-times estimate on these frames
-  double err = 0;         // sqrt(var_between + var_within)
+  double d = 0;    // the all-reference-times estimate on these frames
+  double err = 0;  // sqrt(var_between + var_within)
   double var_between = 0, var_within = 0;
   long blocks = 0, block_frames = 0, increments_used = 0;
 };
@@ -81,9 +80,9 @@ MsdSlopeError msd_slope_error(const IncrementGram& g, double dt, double lo, doub
 // gives the delete-one-block jackknife. Psi (every definition) and dv with their errors come
 // from that jackknife.
 struct PersistenceEstimate {
-  Autocorrelation c;    // C(tau) over all origins (mask-weighted)
+  Autocorrelation c;  // C(tau) over all origins (mask-weighted)
   double dv = 0, dv_err = 0;
-  Persistence p;        // from c
+  Persistence p;  // from c
   double psi_err = 0, psi_e_err = 0, psi_zero_err = 0, psi_full_err = 0;
   long blocks = 0;
 };

@@ -23,8 +23,8 @@ class Archive {
   bool at_end() const { return pos_ == buf_.size(); }
 
   template <class T>
-    requires(std::is_trivially_copyable_v<T> && !requires(T& t, Archive& a) { t.serialize(a); })
-  void io(T& x) {
+  requires(std::is_trivially_copyable_v<T> &&
+           !requires(T & t, Archive& a) { t.serialize(a); }) void io(T& x) {
     raw(&x, sizeof(T));
   }
   template <class T>
@@ -44,8 +44,7 @@ class Archive {
     }
   }
   template <class S, int R, int C, int O, int MR, int MC>
-    requires(R > 0 && C > 0)
-  void io(Eigen::Matrix<S, R, C, O, MR, MC>& m) {
+  requires(R > 0 && C > 0) void io(Eigen::Matrix<S, R, C, O, MR, MC>& m) {
     raw(m.data(), sizeof(S) * R * C);
   }
   void io(std::vector<bool>& v) {
@@ -63,16 +62,15 @@ class Archive {
     raw(s.data(), n);
   }
   template <class T>
-    requires requires(T& t, Archive& a) { t.serialize(a); }
-  void io(T& x) {
-    x.serialize(*this);
-  }
+  requires requires(T& t, Archive& a) { t.serialize(a); }
+  void io(T& x) { x.serialize(*this); }
   // A named check point inside the stream: a mismatch means a corrupt or foreign file.
   void tag(const char* name) {
     std::string s = name;
     std::string got = s;
     io(got);
-    if (got != s) throw std::runtime_error("checkpoint: expected section '" + s + "', found '" + got + "'");
+    if (got != s)
+      throw std::runtime_error("checkpoint: expected section '" + s + "', found '" + got + "'");
   }
 
  private:

@@ -37,9 +37,9 @@ class DiffusionObserver final : public Observer {
   std::filesystem::path file_;
   std::function<bool(const Dynamics&)> measuring_;
   double exclusion_;
-  long particles_ = 0;   // 0 until the first sample
-  bool walls_ = false;   // samples carry a bulk mask
-  long skipped_ = 0;     // sample marks that fell inside one step with another
+  long particles_ = 0;     // 0 until the first sample
+  bool walls_ = false;     // samples carry a bulk mask
+  long skipped_ = 0;       // sample marks that fell inside one step with another
   long due_at_step_ = -1;  // a sample was due at this step before the window opened
   std::vector<double> x_;  // x displacement relative to the imposed flow since the first sample
   DiffusionAccumulator acc_;
