@@ -82,10 +82,7 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
         cfg.particles.init_file.empty() ? ", bring particles.aspect closer to 1" : ""));
 }
 
-Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
-
-Simulation::Simulation(const Config& cfg, Scene scene)
-    : cfg_(cfg), integrator_(make_integrator(cfg.integrator.type)) {
+StepLimits step_limits(const Config& cfg, double clock_rate, bool implicit_springs) {
   StepLimits lim;
   lim.fixed_dt = cfg.integrator.dt;
   lim.max_displacement = cfg.integrator.max_displacement;
@@ -93,9 +90,17 @@ Simulation::Simulation(const Config& cfg, Scene scene)
   lim.max_overlap_change = overlap_change_limit(cfg);
   lim.max_entry_overlap = cfg.integrator.max_entry_overlap;
   lim.max_strain_step = cfg.integrator.max_strain_step;
-  lim.end_time = cfg.run.strain / scene.flow.clock_rate();
-  if (!integrator_->implicit_springs())
+  lim.end_time = cfg.run.strain / clock_rate;
+  if (!implicit_springs)
     lim.explicit_dt = cfg.integrator.explicit_safety * explicit_stability_dt(cfg);
+  return lim;
+}
+
+Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
+
+Simulation::Simulation(const Config& cfg, Scene scene)
+    : cfg_(cfg), integrator_(make_integrator(cfg.integrator.type)) {
+  const StepLimits lim = step_limits(cfg, scene.flow.clock_rate(), integrator_->implicit_springs());
   const double range = interaction_range_factor(cfg);
   ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
                   integrator_->implicit_springs(), cfg.solver.cholesky);

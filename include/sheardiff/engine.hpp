@@ -48,8 +48,12 @@ double interaction_range_factor(const Config& cfg);
 // Contact stability limit of explicit springs for these parameters (docs/model.md section 7).
 double explicit_stability_dt(const Config& cfg);
 
-// Whether the run needs the rotational unknowns (3 per particle) or only translation (2).
+// Whether the run needs the rotational unknowns (3 per disc, 6 per sphere) or only translation.
 bool rotational_unknowns(const Config& cfg);
+
+// The limits on one step a configuration sets (docs/model.md section 7), for a flow whose clock
+// runs at clock_rate and an integrator with (implicit_springs) or without implicit springs.
+StepLimits step_limits(const Config& cfg, double clock_rate, bool implicit_springs);
 
 // The checks of a configuration that need the physics or input files (parse_config does the
 // rest): a fixed dt of explicit springs below their stability limit, particles.init_file

@@ -6,8 +6,10 @@
 
 namespace sheardiff {
 
-Dynamics::Dynamics(Particles particles, Box box, ImposedFlow flow, ForceBalance force_balance,
-                   NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls)
+template <class D>
+DynamicsOf<D>::DynamicsOf(Particles particles, Box box, ImposedFlow flow,
+                          ForceBalance force_balance, NeighbourList neighbours, StepLimits limits,
+                          std::optional<WallBodies> walls)
     : particles_(std::move(particles)),
       box_(box),
       flow_(flow),
@@ -18,17 +20,20 @@ Dynamics::Dynamics(Particles particles, Box box, ImposedFlow flow, ForceBalance 
   rebuild();
 }
 
-void Dynamics::rebuild() {
+template <class D>
+void DynamicsOf<D>::rebuild() {
   neighbours_.rebuild(particles_, box_);
   force_balance_.on_rebuild(particles_, neighbours_.pairs());
 }
 
-double Dynamics::height() const {
+template <class D>
+double DynamicsOf<D>::height() const {
   if (!walls_) return box_.ly;
   return mean_height(particles_, walls_->top) - mean_height(particles_, walls_->bottom);
 }
 
-void Dynamics::begin_step() {
+template <class D>
+void DynamicsOf<D>::begin_step() {
   // The rebuild waits until here so that pair terms stay those of the last solve until then
   // (observers read forces after the move).
   if (rebuild_due_) {
@@ -37,22 +42,28 @@ void Dynamics::begin_step() {
   }
   ForceBalance::update_contacts(particles_, box_, neighbours_.pairs());
   // A driven wall moves with the fluid at its height (the bottom wall is the flow's rest frame).
-  if (walls_ && walls_->top_role != WallRole::Fixed)
-    walls_->driven_vx = flow_.velocity(Vec2(0.0, mean_height(particles_, walls_->top))).x();
+  if (walls_ && walls_->top_role != WallRole::Fixed) {
+    Point top = Point::Zero();
+    top.y() = mean_height(particles_, walls_->top);
+    walls_->driven_vx = flow_.velocity(top).x();
+  }
 }
 
-bool Dynamics::solve(double dt_implicit, Velocities& v) {
+template <class D>
+bool DynamicsOf<D>::solve(double dt_implicit, Velocities& v) {
   return force_balance_.solve(particles_, box_, flow_, neighbours_.pairs(), dt_implicit,
                               wall_bodies(), v);
 }
 
-bool Dynamics::resolve_with_sticking(double dt_implicit, const std::vector<std::size_t>& switched,
-                                     Velocities& v) {
+template <class D>
+bool DynamicsOf<D>::resolve_with_sticking(double dt_implicit,
+                                          const std::vector<std::size_t>& switched, Velocities& v) {
   return force_balance_.resolve_with_sticking(particles_, box_, flow_, neighbours_.pairs(),
                                               switched, dt_implicit, wall_bodies(), v);
 }
 
-int Dynamics::stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched) {
+template <class D>
+int DynamicsOf<D>::stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched) {
   return force_balance_.stick_reversed_sliding(particles_, neighbours_.pairs(), v.u, switched);
 }
 
@@ -78,19 +89,22 @@ const char* to_string(StepLimit l) {
   return "?";
 }
 
-double Dynamics::fixed_step() const {
+template <class D>
+double DynamicsOf<D>::fixed_step() const {
   const double rest = limits_.end_time - time_;
   return rest > 0.0 && rest < limits_.fixed_dt ? rest : limits_.fixed_dt;
 }
 
-double Dynamics::landed(double dt) const {
+template <class D>
+double DynamicsOf<D>::landed(double dt) const {
   const double rate = flow_.clock_rate();
   if (limits_.fixed_dt > 0.0 || landing_ <= 0.0 || rate <= 0.0) return dt;
   const double to_go = landing_ / rate - time_;
   return to_go > 0.0 && dt >= to_go ? to_go : dt;
 }
 
-double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
+template <class D>
+double DynamicsOf<D>::dt_limit(const Velocities& v, StepLimit* which) const {
   StepLimit why = StepLimit::Fixed;
   const auto take = [&](double cand, double& dt, StepLimit l) {
     if (cand < dt) dt = cand, why = l;
@@ -105,8 +119,9 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   why = StepLimit::Strain;
   double vmax = 0.0;
   for (std::size_t i = 0; i < particles_.n_mobile; ++i) {
-    const Vec3 na = v.u[i] - force_balance_.fluid_velocity(flow_, v, particles_.position[i]);
-    vmax = std::max(vmax, na.head<2>().squaredNorm());
+    const typename D::Body na =
+        v.u[i] - force_balance_.fluid_velocity(flow_, v, particles_.position[i]);
+    vmax = std::max(vmax, na.template head<D::space>().squaredNorm());
   }
   vmax = std::sqrt(vmax);
   if (walls_) vmax = std::max(vmax, std::abs(v.wall_v));
@@ -116,10 +131,11 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   const auto& terms = force_balance_.terms();
   const double delta = force_balance_.lubrication() ? force_balance_.lubrication()->delta : 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const PairTerm& t = terms[k];
+    const auto& t = terms[k];
     if (!t.on) continue;
-    const Vec3 uj = v.u[pairs[k].j] + t.image_j;
-    const double opening = t.g.n.dot(uj.head<2>() - v.u[pairs[k].i].head<2>());
+    const typename D::Body uj = v.u[pairs[k].j] + t.image_j;
+    const double opening =
+        t.g.n.dot(uj.template head<D::space>() - v.u[pairs[k].i].template head<D::space>());
     if (pairs[k].history.touching) {
       if (opening != 0.0)
         take(limits_.max_overlap_change / std::abs(opening), dt, StepLimit::Overlap);
@@ -135,19 +151,23 @@ double Dynamics::dt_limit(const Velocities& v, StepLimit* which) const {
   return dt;
 }
 
-void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
+template <class D>
+void DynamicsOf<D>::advance(double dt, const Velocities& v, bool allow_rebuild) {
   // The pair laws' histories (contact springs) advance at the geometry of the start of the
   // step (recomputed: after a Heun corrector the pair terms hold the predicted geometry) ...
   auto& pairs = neighbours_.pairs();
   force_balance_.advance_histories(particles_, box_, flow_, pairs, v.u, dt);
   na_.resize(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const Vec2 step = v.u[i].head<2>() * dt;
+    const Point step = v.u[i].template head<D::space>() * dt;
     if (particles_.motion[i] == Motion::FixedWall) {
       na_[i].setZero();
       continue;
     }
-    na_[i] = step - force_balance_.fluid_velocity(flow_, v, particles_.position[i]).head<2>() * dt;
+    na_[i] =
+        step -
+        force_balance_.fluid_velocity(flow_, v, particles_.position[i]).template head<D::space>() *
+            dt;
     particles_.position[i] += step;
     particles_.unwrapped[i] += step;
     particles_.velocity[i] = v.u[i];
@@ -160,7 +180,8 @@ void Dynamics::advance(double dt, const Velocities& v, bool allow_rebuild) {
   if (allow_rebuild && neighbours_.needs_rebuild()) rebuild_due_ = true;
 }
 
-void Dynamics::serialize(Archive& a, bool layout5) {
+template <class D>
+void DynamicsOf<D>::serialize(Archive& a, bool layout5) {
   a.tag("dynamics");
   a.io(particles_.position);
   a.io(particles_.unwrapped);
@@ -181,7 +202,7 @@ void Dynamics::serialize(Archive& a, bool layout5) {
   if (a.loading() && walls_) walls_->driven_vx = wall_state[0];
   if (layout5) {
     a.tag("images");
-    particles_.image.resize(particles_.size(), {0, 0});
+    particles_.image.resize(particles_.size(), typename D::Images{});
     a.io(particles_.image);
   } else if (a.loading()) {
     estimate_images();
@@ -191,28 +212,35 @@ void Dynamics::serialize(Archive& a, bool layout5) {
   if (a.loading()) force_balance_.on_rebuild(particles_, neighbours_.pairs(), layout5);
 }
 
-void Dynamics::estimate_images() {
+template <class D>
+void DynamicsOf<D>::estimate_images() {
   // Exact in y and without Lees-Edwards; in x under Lees-Edwards the nearest count, which is
   // what a checkpoint of an earlier layout (no counts) can give.
   Particles& p = particles_;
-  p.image.assign(p.size(), {0, 0});
+  p.image.assign(p.size(), typename D::Images{});
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double iy =
         box_.lees_edwards ? std::round((p.unwrapped[i].y() - p.position[i].y()) / box_.ly) : 0.0;
     const double ix =
         std::round((p.unwrapped[i].x() - p.position[i].x() - iy * box_.le_offset) / box_.lx);
-    p.image[i] = {static_cast<int>(ix), static_cast<int>(iy)};
+    p.image[i][0] = static_cast<int>(ix);
+    p.image[i][1] = static_cast<int>(iy);
+    if constexpr (D::space == 3)
+      p.image[i][2] =
+          static_cast<int>(std::round((p.unwrapped[i].z() - p.position[i].z()) / box_.lz));
   }
 }
 
-Dynamics::Saved Dynamics::save() const {
+template <class D>
+typename DynamicsOf<D>::Saved DynamicsOf<D>::save() const {
   Saved s{particles_.position, particles_.unwrapped, particles_.image, {}, box_, time_};
   s.contacts.reserve(neighbours_.pairs().size());
-  for (const Pair& pr : neighbours_.pairs()) s.contacts.push_back(pr.history);
+  for (const auto& pr : neighbours_.pairs()) s.contacts.push_back(pr.history);
   return s;
 }
 
-void Dynamics::restore(const Saved& s) {
+template <class D>
+void DynamicsOf<D>::restore(const Saved& s) {
   particles_.position = s.position;
   particles_.unwrapped = s.unwrapped;
   particles_.image = s.image;
@@ -222,5 +250,8 @@ void Dynamics::restore(const Saved& s) {
   for (std::size_t k = 0; k < pairs.size(); ++k) pairs[k].history = s.contacts[k];
   // The Verlet bookkeeping of the undone move stays counted: that only rebuilds earlier.
 }
+
+template class DynamicsOf<Dim2>;
+template class DynamicsOf<Dim3>;
 
 }  // namespace sheardiff

@@ -8,7 +8,8 @@ namespace {
 constexpr int kStickPasses = 4;  // re-solves per step for sliding contacts that stick
 }  // namespace
 
-bool ExplicitEuler::step(Dynamics& d) {
+template <class D>
+bool ExplicitEulerOf<D>::step(DynamicsOf<D>& d) {
   d.begin_step();
   if (!d.solve(0.0, last_)) return false;
   ++solves_;
@@ -20,7 +21,8 @@ bool ExplicitEuler::step(Dynamics& d) {
   return true;
 }
 
-bool Heun::step(Dynamics& d) {
+template <class D>
+bool HeunOf<D>::step(Dynamics& d) {
   d.begin_step();
   if (!d.solve(0.0, predictor_)) return false;
   ++solves_;
@@ -28,7 +30,7 @@ bool Heun::step(Dynamics& d) {
   dt_ = d.landed(d.dt_limit(predictor_, &why));
   d.count_step_limit(why);
   predictor_terms_ = d.force_balance().terms();
-  const Dynamics::Saved start = d.save();
+  const typename Dynamics::Saved start = d.save();
   d.advance(dt_, predictor_, /*allow_rebuild=*/false);
   const bool ok = d.solve(0.0, last_);
   ++solves_;
@@ -46,7 +48,8 @@ bool Heun::step(Dynamics& d) {
   return true;
 }
 
-bool ImplicitSprings::step(Dynamics& d) {
+template <class D>
+bool ImplicitSpringsOf<D>::step(DynamicsOf<D>& d) {
   d.begin_step();
   const bool fixed = d.limits().fixed_dt > 0.0;
   double dt = fixed ? d.fixed_step() : next_dt_;
@@ -96,16 +99,26 @@ bool ImplicitSprings::step(Dynamics& d) {
   return true;
 }
 
-std::unique_ptr<Integrator> make_integrator(IntegratorType type) {
+template <class D>
+std::unique_ptr<IntegratorOf<D>> make_integrator_of(IntegratorType type) {
   switch (type) {
     case IntegratorType::Euler:
-      return std::make_unique<ExplicitEuler>();
+      return std::make_unique<ExplicitEulerOf<D>>();
     case IntegratorType::Heun:
-      return std::make_unique<Heun>();
+      return std::make_unique<HeunOf<D>>();
     case IntegratorType::Implicit:
-      return std::make_unique<ImplicitSprings>();
+      return std::make_unique<ImplicitSpringsOf<D>>();
   }
   return nullptr;
 }
+
+template class ExplicitEulerOf<Dim2>;
+template class ExplicitEulerOf<Dim3>;
+template class HeunOf<Dim2>;
+template class HeunOf<Dim3>;
+template class ImplicitSpringsOf<Dim2>;
+template class ImplicitSpringsOf<Dim3>;
+template std::unique_ptr<IntegratorOf<Dim2>> make_integrator_of<Dim2>(IntegratorType);
+template std::unique_ptr<IntegratorOf<Dim3>> make_integrator_of<Dim3>(IntegratorType);
 
 }  // namespace sheardiff

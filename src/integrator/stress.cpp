@@ -4,7 +4,8 @@
 
 namespace sheardiff {
 
-StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz) {
+template <class D>
+StressSample measure_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double lz) {
   return measure_stress(d, d.force_balance().terms(), v, lz);
 }
 
@@ -22,18 +23,18 @@ StressSample average(const StressSample& a, const StressSample& b) {
   return m;
 }
 
-StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& terms,
-                            const Velocities& v, double lz) {
+template <class D>
+StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf<D>>& terms,
+                            const VelocitiesOf<D>& v, double lz) {
   StressSample s;
   const auto& pairs = d.neighbours().pairs();
-  const Particles& p = d.particles();
+  const auto& p = d.particles();
   double overlap_sum = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const PairTerm& t = terms[k];
+    const auto& t = terms[k];
     if (!t.on) continue;
-    const Pair& pr = pairs[k];
-    const Vec6 f = t.force(v.u[pr.i], v.u[pr.j]);
-    const Vec2 fj = f.segment<2>(3);
+    const auto& pr = pairs[k];
+    const auto fj = t.force(v.u[pr.i], v.u[pr.j]).template segment<D::space>(D::body).eval();
     const bool contact = pr.history.touching;
     const double l = contact ? t.g.r : t.g.s;
     s.sxx -= l * t.g.n.x() * fj.x();
@@ -59,6 +60,7 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
         break;
     }
   }
+  if constexpr (D::space == 3) lz = d.box().lz;
   const double area = d.box().lx * d.height() * lz;
   s.sxx /= area;
   s.syy /= area;
@@ -66,6 +68,13 @@ StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& term
   s.mean_overlap = s.contacts ? overlap_sum / s.contacts : 0.0;
   return s;
 }
+
+template StressSample measure_stress(const Dynamics&, const Velocities&, double);
+template StressSample measure_stress(const Dynamics3&, const VelocitiesOf<Dim3>&, double);
+template StressSample measure_stress(const Dynamics&, const std::vector<PairTerm>&,
+                                     const Velocities&, double);
+template StressSample measure_stress(const Dynamics3&, const std::vector<PairTermOf<Dim3>>&,
+                                     const VelocitiesOf<Dim3>&, double);
 
 double normal_load_between(const Dynamics& d, const Velocities& v, double y1, double y2,
                            double lz) {

@@ -5,20 +5,34 @@
 namespace sheardiff {
 
 namespace {
-PairGeometry pair_geometry(const Particles& p, const Box& box, const Pair& pr) {
-  return PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+template <class D>
+PairGeometryOf<D> pair_geometry(const ParticlesOf<D>& p, const BoxOf<D>& box, const PairOf<D>& pr) {
+  return PairGeometryOf<D>::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+}
+// A pair's generalised velocity from its particles'.
+template <class D>
+typename D::PairVector pair_velocity(const typename D::Body& ui, const typename D::Body& uj) {
+  typename D::PairVector u;
+  u << ui, uj;
+  return u;
 }
 }  // namespace
 
-ForceBalance::ForceBalance(PairLaws laws, int dof, bool implicit_springs,
-                           const std::string& cholesky)
+template <class D>
+ForceBalanceOf<D>::ForceBalanceOf(PairLaws laws, int dof, bool implicit_springs,
+                                  const std::string& cholesky)
     : laws_(std::move(laws)),
       system_(dof, cholesky),
       diagonal_only_(!laws_.resistive() && !implicit_springs) {}
 
-void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs, bool restored) {
+template <class D>
+void ForceBalanceOf<D>::on_rebuild(const Particles& p, const std::vector<Pair>& pairs,
+                                   bool restored) {
   terms_.assign(pairs.size(), PairTerm{});
-  if (fluid_) {
+  if constexpr (D::space == 3) {
+    system_.set_pattern(p.n_mobile, pairs, p, diagonal_only_);
+    (void)restored;
+  } else if (fluid_) {
     if (!restored || pattern_y_.size() != p.n_mobile) {
       pattern_y_.resize(p.n_mobile);
       for (std::size_t i = 0; i < p.n_mobile; ++i) pattern_y_[i] = p.position[i].y();
@@ -32,46 +46,49 @@ void ForceBalance::on_rebuild(const Particles& p, const std::vector<Pair>& pairs
   }
 }
 
-void ForceBalance::update_contacts(const Particles& p, const Box& box, std::vector<Pair>& pairs) {
+template <class D>
+void ForceBalanceOf<D>::update_contacts(const Particles& p, const Box& box,
+                                        std::vector<Pair>& pairs) {
   for (Pair& pr : pairs) {
     const double r = pair_separation(p, box, pr).norm();
     const bool touching = r <= p.radius[pr.i] + p.radius[pr.j];
-    if (touching != pr.history.touching) pr.history = PairHistory{touching, {}};
+    if (touching != pr.history.touching) pr.history = PairHistoryOf<D>{touching, {}};
   }
 }
 
-void ForceBalance::advance_histories(const Particles& p, const Box& box, const ImposedFlow& flow,
-                                     std::vector<Pair>& pairs, const std::vector<Vec3>& u,
-                                     double dt) const {
+template <class D>
+void ForceBalanceOf<D>::advance_histories(const Particles& p, const Box& box,
+                                          const ImposedFlow& flow, std::vector<Pair>& pairs,
+                                          const std::vector<Body>& u, double dt) const {
   if (!laws_.keeps_history()) return;
   for (Pair& pr : pairs) {
     if (!pr.history.touching) continue;
-    Vec6 up;
-    up << u[pr.i], u[pr.j];
-    if (p.motion[pr.j] == Motion::Mobile) up[3] += flow.image_velocity_x(pr.ky, box.ly);
-    laws_.advance(pr.history, pair_geometry(p, box, pr), up, dt);
+    auto up = pair_velocity<D>(u[pr.i], u[pr.j]);
+    if (p.motion[pr.j] == Motion::Mobile) up[D::body] += flow.image_velocity_x(pr.ky, box.ly);
+    laws_.advance(pr.history, pair_geometry<D>(p, box, pr), up, dt);
   }
 }
 
-void ForceBalance::cap_histories(const Particles& p, const Box& box,
-                                 std::vector<Pair>& pairs) const {
+template <class D>
+void ForceBalanceOf<D>::cap_histories(const Particles& p, const Box& box,
+                                      std::vector<Pair>& pairs) const {
   if (!laws_.keeps_history()) return;
   for (Pair& pr : pairs)
-    if (pr.history.touching) laws_.cap(pr.history, pair_geometry(p, box, pr));
+    if (pr.history.touching) laws_.cap(pr.history, pair_geometry<D>(p, box, pr));
 }
 
-int ForceBalance::stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
-                                         const std::vector<Vec3>& u,
-                                         std::vector<std::size_t>* switched) const {
+template <class D>
+int ForceBalanceOf<D>::stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
+                                              const std::vector<Body>& u,
+                                              std::vector<std::size_t>* switched) const {
   (void)p;
   if (switched) switched->clear();
   int changed = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    PairHistory& h = pairs[k].history;
+    auto& h = pairs[k].history;
     if (!h.touching || !h.contact.sliding) continue;
     const PairTerm& t = terms_[k];
-    Vec6 up;
-    up << u[pairs[k].i], u[pairs[k].j] + t.image_j;
+    const auto up = pair_velocity<D>(u[pairs[k].i], u[pairs[k].j] + t.image_j);
     if (FrictionalContact::stick_if_unloading(h.contact, t.g, up)) {
       ++changed;
       if (switched) switched->push_back(k);
@@ -80,18 +97,19 @@ int ForceBalance::stick_reversed_sliding(const Particles& p, std::vector<Pair>& 
   return changed;
 }
 
+template <class D>
 template <bool kWalls>
-void ForceBalance::assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
-                                  const std::vector<Pair>& pairs, double dt_implicit,
-                                  const WallBodies* walls) {
+void ForceBalanceOf<D>::assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
+                                       const std::vector<Pair>& pairs, double dt_implicit,
+                                       const WallBodies* walls) {
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
-    term.g = PairGeometry::make(pair_separation(p, box, pr), p.radius[pr.i], p.radius[pr.j]);
+    term.g = pair_geometry<D>(p, box, pr);
     term.on = laws_.add_blocks(term.g, pr.history, dt_implicit, term.m, term.f, term.sliding);
     if (!term.on) continue;
-    term.image_j = Vec3::Zero();
-    Vec3 known = Vec3::Zero();
+    term.image_j = Body::Zero();
+    Body known = Body::Zero();
     if constexpr (kWalls) {
       const Motion mj = p.motion[pr.j];
       if (mj == Motion::Mobile)
@@ -107,22 +125,39 @@ void ForceBalance::assemble_pairs(const Particles& p, const Box& box, const Impo
   }
 }
 
-bool ForceBalance::solve(const Particles& p, const Box& box, const ImposedFlow& flow,
-                         const std::vector<Pair>& pairs, double dt_implicit,
-                         const WallBodies* walls, Velocities& out) {
+template <class D>
+bool ForceBalanceOf<D>::solve(const Particles& p, const Box& box, const ImposedFlow& flow,
+                              const std::vector<Pair>& pairs, double dt_implicit,
+                              const WallBodies* walls, Velocities& out) {
   assemble(p, box, flow, pairs, dt_implicit, walls);
   return solve_assembled(p, flow, walls, out);
 }
 
-bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
-                                         const ImposedFlow& flow, const std::vector<Pair>& pairs,
-                                         const std::vector<std::size_t>& switched,
-                                         double dt_implicit, const WallBodies* walls,
-                                         Velocities& out) {
+template <class D>
+std::vector<typename D::PairVector> ForceBalanceOf<D>::slip_rows(const PairGeometryOf<D>& g) {
+  if constexpr (D::space == 2) {
+    return {FrictionalContact::slip_mode(g)};
+  } else {
+    // W^T W = sum over an orthonormal basis t_a of the tangent plane of (t_a^T W)^T (t_a^T W):
+    // W maps into that plane, and two rows carry it all.
+    const Space3 t1 = g.n.unitOrthogonal(), t2 = g.n.cross(t1);
+    const FrictionalContact::SlipMode3 w = FrictionalContact::slip_mode_3d(g);
+    return {(t1.transpose() * w).transpose(), (t2.transpose() * w).transpose()};
+  }
+}
+
+template <class D>
+bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box,
+                                              const ImposedFlow& flow,
+                                              const std::vector<Pair>& pairs,
+                                              const std::vector<std::size_t>& switched,
+                                              double dt_implicit, const WallBodies* walls,
+                                              Velocities& out) {
   // A fresh assembly reads the contacts' new state: taken when a contact with the floating wall
   // switched (its column is not a low-rank term), or when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
-  const bool over_budget = !system_.low_rank_pays(switched.size());
+  constexpr std::size_t kRows = D::space == 2 ? 1 : 2;
+  const bool over_budget = !system_.low_rank_pays(kRows * switched.size());
   bool wall = false;
   for (std::size_t k : switched) wall = wall || p.motion[pairs[k].j] == Motion::FloatingWall;
   sticking_.switched += static_cast<long>(switched.size());
@@ -132,53 +167,57 @@ bool ForceBalance::resolve_with_sticking(const Particles& p, const Box& box,
   }
   ++sticking_.low_rank;
   const int d = system_.dof();
+  constexpr int B = D::body;
   VecX w, dg;
   for (std::size_t k : switched) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
     const double kt = dt_implicit * contact().kt_of(term.g);
-    const Vec6 w6 = FrictionalContact::slip_mode(term.g);
-    // The pair term as a new assembly would make it (stresses read it after the step).
-    term.m += kt * w6 * w6.transpose();
-    term.sliding = false;
     const bool j_mobile = p.motion[pr.j] == Motion::Mobile;
     // Known velocity of j's side: the Lees-Edwards image's, a driven wall's, or zero for a
     // fixed wall.
     const double known_x = j_mobile                               ? term.image_j.x()
                            : p.motion[pr.j] == Motion::DrivenWall ? walls->driven_vx
                                                                   : 0.0;
-    w.setZero(static_cast<Eigen::Index>(system_.unknowns()));
-    dg.setZero(w.size());
-    const double wj_known = w6[3] * known_x;
-    for (int r = 0; r < d; ++r) {
-      w[d * pr.i + r] = w6[r];
-      dg[d * pr.i + r] = -kt * w6[r] * wj_known;
-      if (j_mobile) {
-        w[d * pr.j + r] = w6[3 + r];
-        dg[d * pr.j + r] = -kt * w6[3 + r] * wj_known;
+    term.sliding = false;
+    for (const auto& row : slip_rows(term.g)) {
+      // The pair term as a new assembly would make it (stresses read it after the step).
+      term.m += kt * row * row.transpose();
+      w.setZero(static_cast<Eigen::Index>(system_.unknowns()));
+      dg.setZero(w.size());
+      const double wj_known = row[B] * known_x;
+      for (int r = 0; r < d; ++r) {
+        w[d * pr.i + r] = row[r];
+        dg[d * pr.i + r] = -kt * row[r] * wj_known;
+        if (j_mobile) {
+          w[d * pr.j + r] = row[B + r];
+          dg[d * pr.j + r] = -kt * row[B + r] * wj_known;
+        }
       }
+      system_.add_low_rank(w, kt, dg);
     }
-    system_.add_low_rank(w, kt, dg);
   }
   return solve_assembled(p, flow, walls, out);
 }
 
-void ForceBalance::assemble(const Particles& p, const Box& box, const ImposedFlow& flow,
-                            const std::vector<Pair>& pairs, double dt_implicit,
-                            const WallBodies* walls) {
+template <class D>
+void ForceBalanceOf<D>::assemble(const Particles& p, const Box& box, const ImposedFlow& flow,
+                                 const std::vector<Pair>& pairs, double dt_implicit,
+                                 const WallBodies* walls) {
   if (terms_.size() != pairs.size()) throw std::logic_error("ForceBalance: stale pair list");
   if (dt_implicit > 0.0 && diagonal_only_)
     throw std::logic_error("ForceBalance: implicit springs need the coupled pattern");
   system_.clear();
   for (std::size_t i = 0; i < p.n_mobile; ++i) {
-    const Vec3 drag = StokesDrag::resistance(p.radius[i]);
-    Vec3 force = drag.cwiseProduct(flow.velocity(p.position[i]));
+    const Body drag = StokesDrag::resistance_of<D>(p.radius[i]);
+    Body force = drag.cwiseProduct(flow.velocity(p.position[i]));
     if (!p.external.empty()) force += p.external[i];
     system_.add_self(static_cast<int>(i), drag, force);
   }
-  if (fluid_)
-    fluid_->assemble(p, flow, system_.dof(), static_cast<int>(system_.particle_unknowns()),
-                     system_);
+  if constexpr (D::space == 2)
+    if (fluid_)
+      fluid_->assemble(p, flow, system_.dof(), static_cast<int>(system_.particle_unknowns()),
+                       system_);
   // Scenes without walls get a loop with no wall branch at all.
   if (walls)
     assemble_pairs<true>(p, box, flow, pairs, dt_implicit, walls);
@@ -186,8 +225,9 @@ void ForceBalance::assemble(const Particles& p, const Box& box, const ImposedFlo
     assemble_pairs<false>(p, box, flow, pairs, dt_implicit, walls);
 }
 
-bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
-                                   const WallBodies* walls, Velocities& out) {
+template <class D>
+bool ForceBalanceOf<D>::solve_assembled(const Particles& p, const ImposedFlow& flow,
+                                        const WallBodies* walls, Velocities& out) {
   double v = 0.0, g = 0.0;
   bool capped = false;
   const bool ok =
@@ -199,6 +239,7 @@ bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
   if (!ok) return false;
   if (check_residual_) residual_ = system_.residual(u_, v);
 
+  constexpr int B = D::body;
   const int d = system_.dof();
   out.u.resize(p.size());
   out.wall_v = v;
@@ -208,29 +249,35 @@ bool ForceBalance::solve_assembled(const Particles& p, const ImposedFlow& flow,
     out.pressure_gradient = g;  // the multiplier is G itself: the reference's G0 is in g_
   }
   for (std::size_t i = 0; i < p.size(); ++i) {
+    Body& ui = out.u[i];
     switch (p.motion[i]) {
       case Motion::Mobile:
-        if (d == 3) {
-          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], u_[d * i + 2]);
-        } else {
+        for (int c = 0; c < d; ++c) ui[c] = u_[d * i + c];
+        if (d < B) {
           // Without rotational unknowns only drag (and an external torque) acts on omega.
-          double w = fluid_velocity(flow, out, p.position[i]).z();
-          if (!p.external.empty()) w += p.external[i].z() / StokesDrag::resistance(p.radius[i]).z();
-          out.u[i] = Vec3(u_[d * i], u_[d * i + 1], w);
+          const Body fluid = fluid_velocity(flow, out, p.position[i]);
+          const Body drag = StokesDrag::resistance_of<D>(p.radius[i]);
+          for (int c = d; c < B; ++c)
+            ui[c] = p.external.empty() ? fluid[c] : fluid[c] + p.external[i][c] / drag[c];
         }
         break;
       case Motion::FixedWall:
-        out.u[i].setZero();
+        ui.setZero();
         break;
       case Motion::FloatingWall:
-        out.u[i] = walls ? Vec3(walls->driven_vx, v, 0.0) : Vec3::Zero();
+        ui.setZero();
+        if (walls) ui[0] = walls->driven_vx, ui[1] = v;
         break;
       case Motion::DrivenWall:
-        out.u[i] = walls ? Vec3(walls->driven_vx, 0.0, 0.0) : Vec3::Zero();
+        ui.setZero();
+        if (walls) ui[0] = walls->driven_vx;
         break;
     }
   }
   return true;
 }
+
+template class ForceBalanceOf<Dim2>;
+template class ForceBalanceOf<Dim3>;
 
 }  // namespace sheardiff

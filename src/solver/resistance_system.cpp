@@ -15,8 +15,9 @@ int ResistanceSystem::index(int row, int col) const {
   return static_cast<int>(it - inner);
 }
 
-void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs,
-                                   const Particles& p, bool diagonal_only,
+template <class D>
+void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<PairOf<D>>& pairs,
+                                   const ParticlesOf<D>& p, bool diagonal_only,
                                    std::size_t extra_unknowns,
                                    const std::vector<std::pair<int, int>>& extra_entries) {
   n_ = n_mobile;
@@ -42,7 +43,7 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
   for (std::size_t i = 0; i < n_; ++i)
     for (int r = 0; r < d; ++r)
       for (int c = 0; c <= r; ++c) trip.emplace_back(d * i + r, d * i + c, 0.0);
-  for (const Pair& pr : pairs) {
+  for (const auto& pr : pairs) {
     if (p.motion[pr.j] != Motion::Mobile) continue;
     const int hi = std::max(pr.i, pr.j), lo = std::min(pr.i, pr.j);
     for (int r = 0; r < d; ++r)
@@ -61,7 +62,7 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<Pair>
             index(static_cast<int>(d * i + r), static_cast<int>(d * i + c));
   pair_idx_.assign(pairs.size() * d * d, -1);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const Pair& pr = pairs[k];
+    const auto& pr = pairs[k];
     if (p.motion[pr.j] != Motion::Mobile) continue;
     const int hi = std::max(pr.i, pr.j), lo = std::min(pr.i, pr.j);
     for (int r = 0; r < d; ++r)
@@ -154,7 +155,8 @@ void ResistanceSystem::clear() {
   mult_ = 0.0;
 }
 
-void ResistanceSystem::add_self(int i, const Vec3& resistance, const Vec3& force) {
+template <class Body>
+void ResistanceSystem::add_self_of(int i, const Body& resistance, const Body& force) {
   for (int r = 0; r < dof_; ++r) {
     const std::size_t row = static_cast<std::size_t>(dof_) * i + r;
     if (diagonal_only_)
@@ -165,12 +167,16 @@ void ResistanceSystem::add_self(int i, const Vec3& resistance, const Vec3& force
   }
 }
 
-void ResistanceSystem::add_pair(std::size_t k, const Pair& pr, const Mat6& m, const Vec6& f,
-                                const Vec3& known_j, bool j_mobile, bool j_floating) {
+template <class PairType, class Matrix, class Vector, class Body>
+void ResistanceSystem::add_pair(std::size_t k, const PairType& pr, const Matrix& m, const Vector& f,
+                                const Body& known_j, bool j_mobile, bool j_floating) {
+  // B: components of one particle's generalised velocity; j's start at B, its y velocity at
+  // B + 1.
+  constexpr int B = Body::RowsAtCompileTime;
   const int d = dof_;
   double* val = diagonal_only_ ? nullptr : a_.valuePtr();
   // Right-hand side: spring force minus the resistance against j's known velocity.
-  const Vec6 rhs = f - m.rightCols<3>() * known_j;
+  const Vector rhs = f - m.template rightCols<B>() * known_j;
   for (int r = 0; r < d; ++r) g_[d * pr.i + r] += rhs[r];
   if (!diagonal_only_) {
     for (int r = 0; r < d; ++r)
@@ -179,24 +185,38 @@ void ResistanceSystem::add_pair(std::size_t k, const Pair& pr, const Mat6& m, co
     for (int r = 0; r < d; ++r) diag_[d * pr.i + r] += m(r, r);
   }
   if (j_mobile) {
-    for (int r = 0; r < d; ++r) g_[d * pr.j + r] += rhs[3 + r];
+    for (int r = 0; r < d; ++r) g_[d * pr.j + r] += rhs[B + r];
     if (!diagonal_only_) {
       for (int r = 0; r < d; ++r)
-        for (int c = 0; c <= r; ++c) val[diag_idx_[(pr.j * d + r) * d + c]] += m(3 + r, 3 + c);
+        for (int c = 0; c <= r; ++c) val[diag_idx_[(pr.j * d + r) * d + c]] += m(B + r, B + c);
       // Block of row particle max(i, j) and column particle min(i, j).
       const bool j_hi = pr.j > pr.i;
       for (int r = 0; r < d; ++r)
         for (int c = 0; c < d; ++c)
-          val[pair_idx_[(k * d + r) * d + c]] += j_hi ? m(3 + r, c) : m(r, 3 + c);
+          val[pair_idx_[(k * d + r) * d + c]] += j_hi ? m(B + r, c) : m(r, B + c);
     } else {
-      for (int r = 0; r < d; ++r) diag_[d * pr.j + r] += m(3 + r, 3 + r);
+      for (int r = 0; r < d; ++r) diag_[d * pr.j + r] += m(B + r, B + r);
     }
   } else if (j_floating) {
-    for (int r = 0; r < d; ++r) b_[d * pr.i + r] += m(r, 4);
-    c_ += m(4, 4);
-    wall_rhs_ += rhs[4];
+    for (int r = 0; r < d; ++r) b_[d * pr.i + r] += m(r, B + 1);
+    c_ += m(B + 1, B + 1);
+    wall_rhs_ += rhs[B + 1];
   }
 }
+
+// Discs and spheres.
+template void ResistanceSystem::set_pattern<Dim2>(std::size_t, const std::vector<Pair>&,
+                                                  const Particles&, bool, std::size_t,
+                                                  const std::vector<std::pair<int, int>>&);
+template void ResistanceSystem::set_pattern<Dim3>(std::size_t, const std::vector<Pair3>&,
+                                                  const Particles3&, bool, std::size_t,
+                                                  const std::vector<std::pair<int, int>>&);
+template void ResistanceSystem::add_self_of(int, const Vec3&, const Vec3&);
+template void ResistanceSystem::add_self_of(int, const Vec6&, const Vec6&);
+template void ResistanceSystem::add_pair(std::size_t, const Pair&, const Mat6&, const Vec6&,
+                                         const Vec3&, bool, bool);
+template void ResistanceSystem::add_pair(std::size_t, const Pair3&, const Mat12&, const Vec12&,
+                                         const Vec6&, bool, bool);
 
 void ResistanceSystem::add_value(int row, int col, double v) {
   a_.valuePtr()[index(row, col)] += v;

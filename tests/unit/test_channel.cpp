@@ -45,8 +45,8 @@ FluidSolve solve_pinned(const Particles& p, const FluidLayer& fl, const ImposedF
   sys.clear();
   for (std::size_t i = 0; i < p.n_mobile; ++i) {
     const Vec3 zeta = StokesDrag::resistance(p.radius[i]);
-    sys.add_self(static_cast<int>(i), zeta + Vec3(pin, pin, 0.0),
-                 zeta.cwiseProduct(ref.velocity(p.position[i])));
+    sys.add_self(static_cast<int>(i), Vec3(zeta + Vec3(pin, pin, 0.0)),
+                 Vec3(zeta.cwiseProduct(ref.velocity(p.position[i]))));
   }
   fl.assemble(p, ref, 2, base, sys);
   FluidSolve s;

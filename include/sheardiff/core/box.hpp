@@ -1,5 +1,7 @@
 #pragma once
-#include "sheardiff/core/types.hpp"
+#include <type_traits>
+
+#include "sheardiff/core/dimension.hpp"
 
 namespace sheardiff {
 
@@ -17,5 +19,18 @@ struct Box {
   // Shift of the periodic image (kx, ky) at the current time.
   Vec2 image_shift(int kx, int ky) const { return {kx * lx + ky * le_offset, ky * ly}; }
 };
+
+// The cell of spheres: the same in x and y, and periodic in z (the vorticity direction) with
+// length lz.
+struct Box3 : Box {
+  double lz = 1.0;
+
+  Space3 image_shift(int kx, int ky, int kz) const {
+    return {kx * lx + ky * le_offset, ky * ly, kz * lz};
+  }
+};
+
+template <class D>
+using BoxOf = std::conditional_t<D::space == 2, Box, Box3>;
 
 }  // namespace sheardiff

@@ -27,6 +27,13 @@ struct ImposedFlow {
     const double dy = x.y() - y0;
     return {dy * (gammadot + curvature * dy), 0.0, -0.5 * (gammadot + 2.0 * curvature * dy)};
   }
+  // Spheres: (v, omega) of the fluid at x; the flow is in x, varies in y, turns about z.
+  Vec6 velocity(const Space3& x) const {
+    const Vec3 plane = velocity(Vec2(x.x(), x.y()));
+    Vec6 v;
+    v << plane.x(), plane.y(), 0.0, 0.0, 0.0, plane.z();
+    return v;
+  }
   // grad v at x, (grad v)_ab = d v_a / d x_b.
   Mat2 gradient(const Vec2& x) const {
     Mat2 g;

@@ -3,12 +3,22 @@
 // pair laws read and advance it; interactions/pair_laws.hpp maps each law to its member). A law
 // that keeps a per-contact history adds one member here.
 
+#include <type_traits>
+
+#include "sheardiff/core/dimension.hpp"
+
 namespace sheardiff {
 
 // The tangential spring of a frictional contact (interactions/contact.hpp is its law).
 struct TangentialSpring {
   double xi = 0.0;       // scalar tangential spring stretch (2D)
   bool sliding = false;  // the last step capped xi at the Coulomb limit
+};
+
+// The same between two spheres: a vector in the plane normal to the line of centres.
+struct TangentialSpring3 {
+  Space3 xi = Space3::Zero();
+  bool sliding = false;
 };
 
 // Whether the pair touches (decided at the start of a step, shared by every law) and the
@@ -18,5 +28,12 @@ struct PairHistory {
   bool touching = false;
   TangentialSpring contact;
 };
+struct PairHistory3 {
+  bool touching = false;
+  TangentialSpring3 contact;
+};
+
+template <class D>
+using PairHistoryOf = std::conditional_t<D::space == 2, PairHistory, PairHistory3>;
 
 }  // namespace sheardiff

@@ -18,6 +18,7 @@ using VecX = Eigen::VectorXd;
 using Space3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
+using Vec12 = Eigen::Matrix<double, 12, 1>;
 
 inline constexpr double kPi = 3.14159265358979323846;
 

@@ -34,11 +34,21 @@ enum class StepLimit : int { Fixed, Strain, Displacement, Gap, Overlap, Explicit
 const char* to_string(StepLimit l);
 
 // The state of a run and the operations an integrator composes: solve for velocities at the
-// current configuration, pick a step, move everything by a step. No policy lives here.
-class Dynamics {
+// current configuration, pick a step, move everything by a step. No policy lives here. Discs
+// (D = Dim2) or spheres (Dim3).
+template <class D>
+class DynamicsOf {
  public:
-  Dynamics(Particles particles, Box box, ImposedFlow flow, ForceBalance force_balance,
-           NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls);
+  using Point = typename D::Point;
+  using Particles = ParticlesOf<D>;
+  using Box = BoxOf<D>;
+  using Pair = PairOf<D>;
+  using NeighbourList = NeighbourListOf<D>;
+  using ForceBalance = ForceBalanceOf<D>;
+  using Velocities = VelocitiesOf<D>;
+
+  DynamicsOf(Particles particles, Box box, ImposedFlow flow, ForceBalance force_balance,
+             NeighbourList neighbours, StepLimits limits, std::optional<WallBodies> walls);
 
   // Opens/closes contacts at the current configuration; call once at the start of a step.
   void begin_step();
@@ -82,9 +92,9 @@ class Dynamics {
   void serialize(Archive& a, bool layout5 = true);
 
   struct Saved {
-    std::vector<Vec2> position, unwrapped;
-    std::vector<std::array<int, 2>> image;
-    std::vector<PairHistory> contacts;
+    std::vector<Point> position, unwrapped;
+    std::vector<typename D::Images> image;
+    std::vector<PairHistoryOf<D>> contacts;
     Box box;
     double time;
   };
@@ -132,7 +142,10 @@ class Dynamics {
   long steps_ = 0;
   bool rebuild_due_ = false;
   std::array<long, static_cast<int>(StepLimit::Count)> limit_counts_{};
-  std::vector<Vec2> na_;  // scratch: non-affine displacement of the last step
+  std::vector<Point> na_;  // scratch: non-affine displacement of the last step
 };
+
+using Dynamics = DynamicsOf<Dim2>;
+using Dynamics3 = DynamicsOf<Dim3>;
 
 }  // namespace sheardiff

@@ -7,10 +7,15 @@
 
 namespace sheardiff {
 
-// A time-stepping policy over Dynamics (docs/model.md section 7).
-class Integrator {
+// A time-stepping policy over Dynamics (docs/model.md section 7), for discs (D = Dim2) or
+// spheres (Dim3).
+template <class D>
+class IntegratorOf {
  public:
-  virtual ~Integrator() = default;
+  using Dynamics = DynamicsOf<D>;
+  using Velocities = VelocitiesOf<D>;
+
+  virtual ~IntegratorOf() = default;
   // Advance one step. Returns false if a linear solve failed (state is then unchanged).
   virtual bool step(Dynamics& d) = 0;
   // The velocities at the configuration as it is, springs explicit, nothing moved: the state
@@ -48,14 +53,20 @@ class Integrator {
 };
 
 // Springs explicit, one solve per step.
-class ExplicitEuler final : public Integrator {
+template <class D>
+class ExplicitEulerOf final : public IntegratorOf<D> {
  public:
-  bool step(Dynamics& d) override;
+  bool step(DynamicsOf<D>& d) override;
+
+ private:
+  using IntegratorOf<D>::last_, IntegratorOf<D>::dt_, IntegratorOf<D>::solves_;
 };
 
 // Springs explicit, predictor-corrector (two solves per step, second order).
-class Heun final : public Integrator {
+template <class D>
+class HeunOf final : public IntegratorOf<D> {
  public:
+  using Dynamics = DynamicsOf<D>;
   bool step(Dynamics& d) override;
   // The particles moved with the mean of the two stages' velocities, so the stress is the mean
   // of the two stages' samples, each at its own geometry: the wall then carries exactly P Lx lz
@@ -66,28 +77,31 @@ class Heun final : public Integrator {
   }
 
  private:
-  Velocities predictor_, corrector_;
-  std::vector<PairTerm> predictor_terms_, corrector_terms_;
+  using IntegratorOf<D>::last_, IntegratorOf<D>::dt_, IntegratorOf<D>::solves_;
+  VelocitiesOf<D> predictor_, corrector_;
+  std::vector<PairTermOf<D>> predictor_terms_, corrector_terms_;
 };
 
 // Linearly implicit springs: (A + dt K) U = g, stable for any dt; dt chosen by accuracy from
 // the previous velocities, and the step is redone with a smaller dt if the solved velocities
 // overshoot the limits by more than `overshoot`.
-class ImplicitSprings final : public Integrator {
+template <class D>
+class ImplicitSpringsOf final : public IntegratorOf<D> {
  public:
-  explicit ImplicitSprings(double growth = 1.25, double overshoot = 1.5)
+  explicit ImplicitSpringsOf(double growth = 1.25, double overshoot = 1.5)
       : growth_(growth), overshoot_(overshoot) {}
-  bool step(Dynamics& d) override;
+  bool step(DynamicsOf<D>& d) override;
   bool implicit_springs() const override { return true; }
   long redos() const { return redos_; }
   void serialize(Archive& a) override {
-    Integrator::serialize(a);
+    IntegratorOf<D>::serialize(a);
     a.io(next_dt_);
     a.io(limit_of_next_);
     a.io(redos_);
   }
 
  private:
+  using IntegratorOf<D>::last_, IntegratorOf<D>::dt_, IntegratorOf<D>::solves_;
   double growth_, overshoot_;
   double next_dt_ = 0.0;
   StepLimit limit_of_next_ = StepLimit::Displacement;
@@ -95,6 +109,15 @@ class ImplicitSprings final : public Integrator {
   std::vector<std::size_t> switched_;  // scratch: contacts switched to sticking in a pass
 };
 
-std::unique_ptr<Integrator> make_integrator(IntegratorType type);
+using Integrator = IntegratorOf<Dim2>;
+using ExplicitEuler = ExplicitEulerOf<Dim2>;
+using Heun = HeunOf<Dim2>;
+using ImplicitSprings = ImplicitSpringsOf<Dim2>;
+
+template <class D>
+std::unique_ptr<IntegratorOf<D>> make_integrator_of(IntegratorType type);
+inline std::unique_ptr<Integrator> make_integrator(IntegratorType type) {
+  return make_integrator_of<Dim2>(type);
+}
 
 }  // namespace sheardiff

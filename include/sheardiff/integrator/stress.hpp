@@ -20,10 +20,13 @@ struct StressSample {
   double bottom_wall_fy = 0.0;
 };
 
-StressSample measure_stress(const Dynamics& d, const Velocities& v, double lz);
+// Discs or spheres; lz is a monolayer's thickness (spheres: the cell's own lz is used).
+template <class D>
+StressSample measure_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double lz);
 // The same with pair terms other than the last solve's (a stage of a multi-stage integrator).
-StressSample measure_stress(const Dynamics& d, const std::vector<PairTerm>& terms,
-                            const Velocities& v, double lz);
+template <class D>
+StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf<D>>& terms,
+                            const VelocitiesOf<D>& v, double lz);
 // The normal load a horizontal band of the packing carries, in pressure units: sum over the
 // pairs whose midpoints lie between heights y1 < y2 of (y_j - y_i) f_y on j, over the band's
 // area (-sigma_yy with the lever arm r for every pair). Where nothing moves on average in y,

@@ -14,7 +14,8 @@ namespace sheardiff {
 struct FrictionalContact {
   // State a contact carries from step to step (whether the pair touches is the pair's own,
   // PairHistory::touching).
-  using History = TangentialSpring;  // core/pair_history.hpp
+  using History = TangentialSpring;    // core/pair_history.hpp
+  using History3 = TangentialSpring3;  // between two spheres
 
   double kn = 1e4;
   double kt = 5e3;
@@ -34,8 +35,14 @@ struct FrictionalContact {
   double scale(const Geometry& g) const {
     return scale_with_radius ? g.ai + g.aj : 1.0;
   }
-  double kn_of(const PairGeometry& g) const { return kn * scale(g); }
-  double kt_of(const PairGeometry& g) const { return kt * scale(g); }
+  template <class Geometry>
+  double kn_of(const Geometry& g) const {
+    return kn * scale(g);
+  }
+  template <class Geometry>
+  double kt_of(const Geometry& g) const {
+    return kt * scale(g);
+  }
 
   static Vec6 normal_mode(const PairGeometry& g) { return sheardiff::normal_mode(g); }
   // Slip direction in pair space: slip rate v_s = -slip_mode . U.
@@ -81,7 +88,10 @@ struct FrictionalContact {
 
   // ---- The pair-law contract (pair_law.hpp) ----
   double range_factor() const { return 1.0; }
-  bool acts(const PairGeometry&, bool touching) const { return touching; }
+  template <class Geometry>
+  bool acts(const Geometry&, bool touching) const {
+    return touching;
+  }
   void add_block(const PairGeometry& g, const History& h, bool, double dt_implicit,
                  PairBlock& b) const {
     const bool friction = has_friction();
@@ -108,17 +118,12 @@ struct FrictionalContact {
     h.sliding = false;
     return true;
   }
-  // ---- Three dimensions (spheres; the law's vector form, not yet driven by the engine) ----
+  // ---- Three dimensions (spheres; the law's vector form) ----
   // The tangential spring is a vector xi in the plane normal to n; in a pair of the x-y plane it
   // is the disc's xi times t = z x n. Pair space: (u, omega)_i, (u, omega)_j.
-  using Vec12 = Eigen::Matrix<double, 12, 1>;
+  using Vec12 = sheardiff::Vec12;
   using SlipMode3 = Eigen::Matrix<double, 3, 12>;
-  static Vec12 normal_mode_3d(const PairGeometry3& g) {
-    Vec12 m = Vec12::Zero();
-    m.segment<3>(0) = g.n;
-    m.segment<3>(6) = -g.n;
-    return m;
-  }
+  static Vec12 normal_mode_3d(const PairGeometry3& g) { return sheardiff::normal_mode(g); }
   // Slip velocity v_s = -W U = (I - n n^T)(u_j - u_i) - (a_i omega_i + a_j omega_j) x n.
   static SlipMode3 slip_mode_3d(const PairGeometry3& g) {
     const Mat3 plane = Mat3::Identity() - g.n * g.n.transpose();
@@ -169,6 +174,28 @@ struct FrictionalContact {
       return true;
     }
     return false;
+  }
+
+  // The contract in three dimensions, as in two: sliding is what the last cap decided; the
+  // spring stretches at the start geometry, then turns with the pair and is capped at the end.
+  void add_block(const PairGeometry3& g, const History3& h, bool, double dt_implicit,
+                 PairBlock3& b) const {
+    const bool friction = has_friction();
+    b.add_force(spring_force_3d(g, friction ? h.xi : Space3::Zero()));
+    b.sliding = friction && h.sliding;
+    if (dt_implicit > 0.0) b.add_matrix(dt_implicit * stiffness_3d(g, b.sliding));
+  }
+  void advance(History3& h, const PairGeometry3& g, const Vec12& u, double dt) const {
+    advance_3d(h.xi, g, u, dt);
+  }
+  void cap(History3& h, const PairGeometry3& g) const {
+    turn_with_pair(h.xi, g.n);
+    h.sliding = apply_coulomb_3d(g, h.xi);
+  }
+  static bool stick_if_unloading(History3& h, const PairGeometry3& g, const Vec12& u) {
+    if (!h.sliding || !(slip_velocity_3d(g, u).dot(h.xi) < 0.0)) return false;
+    h.sliding = false;
+    return true;
   }
 
   void add_stability(double, StabilityTerms& s) const {

@@ -45,14 +45,22 @@ struct Lubrication {
   // h_max is a reduced gap, 2 r / (a_i + a_j) - 2.
   double range_factor() const { return 1.0 + 0.5 * h_max; }
   // A touching pair keeps its dashpots even if the geometry of a predictor moved it apart.
-  bool acts(const PairGeometry& g, bool touching) const { return touching || acts(g.h); }
+  template <class Geometry>
+  bool acts(const Geometry& g, bool touching) const {
+    return touching || acts(g.h);
+  }
   void add_block(const PairGeometry& g, const History&, bool, double, PairBlock& b) const {
     b.add_matrix(coefficients(g.ai, g.aj, g.h).matrix(g.n, g.t));
   }
+  void add_block(const PairGeometry3& g, const History&, bool, double, PairBlock3& b) const {
+    b.add_matrix(coefficients(g.ai, g.aj, g.h).matrix_3d(g.n));
+  }
   bool resistive() const { return true; }
   bool keeps_history() const { return false; }
-  void advance(History&, const PairGeometry&, const Vec6&, double) const {}
-  void cap(History&, const PairGeometry&) const {}
+  template <class Geometry, class PairVelocity>
+  void advance(History&, const Geometry&, const PairVelocity&, double) const {}
+  template <class Geometry>
+  void cap(History&, const Geometry&) const {}
   void add_stability(double a, StabilityTerms& s) const {
     const PairResistance r = coefficients(a, a, 0.0);
     s.normal_damping += r.xa;

@@ -1,7 +1,8 @@
 #pragma once
 #include <cmath>
+#include <type_traits>
 
-#include "sheardiff/core/types.hpp"
+#include "sheardiff/core/dimension.hpp"
 
 namespace sheardiff {
 
@@ -50,5 +51,8 @@ struct PairGeometry3 {
     return g;
   }
 };
+
+template <class D>
+using PairGeometryOf = std::conditional_t<D::space == 2, PairGeometry, PairGeometry3>;
 
 }  // namespace sheardiff

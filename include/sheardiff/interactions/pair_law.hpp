@@ -21,6 +21,9 @@
 //   void add_stability(double a, StabilityTerms&) const;   its stiffness and damping on the
 //                                  smallest pair (radius a) for the explicit stability limit;
 //   bool needs_rotations() const;  whether it couples rotation to translation.
+// Every operation that takes a PairGeometry also takes a PairGeometry3 (two spheres), with
+// PairBlock3, a pair velocity Vec12 and its history in three dimensions (a law that keeps one
+// names it History3), as a template or an overload: the engine is instantiated for both.
 #include "sheardiff/interactions/pair_geometry.hpp"
 
 namespace sheardiff {
@@ -30,10 +33,12 @@ struct NoHistory {};
 
 // Where laws write one pair's matrix block M and force f (the pair's generalised force is
 // -M U_pair + f). The first law to write a part assigns it, later ones add to it, so that a
-// single law gives exactly its own block (bit for bit, not 0 + block).
-struct PairBlock {
-  Mat6& m;
-  Vec6& f;
+// single law gives exactly its own block (bit for bit, not 0 + block). M is 6x6 for two discs,
+// 12x12 for two spheres.
+template <class Matrix, class Vector>
+struct PairBlockOf {
+  Matrix& m;
+  Vector& f;
   bool& sliding;  // a contact at its Coulomb limit (no tangential stiffness this step)
   bool m_set = false, f_set = false;
 
@@ -57,6 +62,9 @@ struct PairBlock {
   }
 };
 
+using PairBlock = PairBlockOf<Mat6, Vec6>;
+using PairBlock3 = PairBlockOf<Mat12, Vec12>;
+
 // What sets the explicit stability limit 2 R / k of the smallest pair: the normal and tangential
 // stiffness of its laws and their damping (plus the drag) at contact.
 struct StabilityTerms {
@@ -69,6 +77,13 @@ struct StabilityTerms {
 inline Vec6 normal_mode(const PairGeometry& g) {
   Vec6 m;
   m << g.n, 0.0, -g.n, 0.0;
+  return m;
+}
+// The same for two spheres, (u, omega)_i, (u, omega)_j.
+inline Vec12 normal_mode(const PairGeometry3& g) {
+  Vec12 m = Vec12::Zero();
+  m.segment<3>(0) = g.n;
+  m.segment<3>(6) = -g.n;
   return m;
 }
 

@@ -17,16 +17,9 @@
 
 namespace sheardiff {
 
-// The history of law L inside a pair's record.
-template <class L>
-decltype(auto) history_of(PairHistory& h) {
-  if constexpr (std::is_same_v<typename L::History, TangentialSpring>)
-    return (h.contact);
-  else
-    return typename L::History{};
-}
-template <class L>
-decltype(auto) history_of(const PairHistory& h) {
+// The history of law L inside a pair's record (PairHistory, or PairHistory3 between spheres).
+template <class L, class Record>
+decltype(auto) history_of(Record& h) {
   if constexpr (std::is_same_v<typename L::History, TangentialSpring>)
     return (h.contact);
   else
@@ -92,11 +85,13 @@ class PairLawSet {
   }
 
   // The block and force of one pair from every law acting on it; false if none acts (then m
-  // and f are left as they were).
-  bool add_blocks(const PairGeometry& g, const PairHistory& h, double dt_implicit, Mat6& m, Vec6& f,
+  // and f are left as they were). Two discs (PairGeometry, PairHistory, Mat6, Vec6) or two
+  // spheres (PairGeometry3, PairHistory3, Mat12, Vec12).
+  template <class Geometry, class Record, class Matrix, class Vector>
+  bool add_blocks(const Geometry& g, const Record& h, double dt_implicit, Matrix& m, Vector& f,
                   bool& sliding) const {
     bool on = false;
-    PairBlock b{m, f, sliding};
+    PairBlockOf<Matrix, Vector> b{m, f, sliding};
     for_each([&](const auto& law) {
       using L = std::decay_t<decltype(law)>;
       if (!law.acts(g, h.touching)) return;
@@ -111,7 +106,8 @@ class PairLawSet {
     return on;
   }
   // The histories of a touching pair over a step (geometry of its start, pair velocity u) ...
-  void advance(PairHistory& h, const PairGeometry& g, const Vec6& u, double dt) const {
+  template <class Record, class Geometry, class PairVelocity>
+  void advance(Record& h, const Geometry& g, const PairVelocity& u, double dt) const {
     for_each([&](const auto& law) {
       using L = std::decay_t<decltype(law)>;
       if constexpr (!std::is_same_v<typename L::History, NoHistory>)
@@ -119,7 +115,8 @@ class PairLawSet {
     });
   }
   // ... and capped at its end.
-  void cap(PairHistory& h, const PairGeometry& g) const {
+  template <class Record, class Geometry>
+  void cap(Record& h, const Geometry& g) const {
     for_each([&](const auto& law) {
       using L = std::decay_t<decltype(law)>;
       if constexpr (!std::is_same_v<typename L::History, NoHistory>)

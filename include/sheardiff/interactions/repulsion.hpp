@@ -25,19 +25,25 @@ struct DoubleLayerRepulsion {
     return DoubleLayerRepulsion{cfg.repulsion.f0, cfg.repulsion.lambda, cfg.repulsion.cutoff};
   }
 
-  static double gap(const PairGeometry& g) { return g.r - g.s; }
+  template <class Geometry>
+  static double gap(const Geometry& g) {
+    return g.r - g.s;
+  }
   // Magnitude of the repulsion at surface gap h.
   double force(double h) const { return f0 * std::exp(-std::max(h, 0.0) / lambda); }
 
   // ---- The pair-law contract (pair_law.hpp) ----
   // The smallest pair has a_i + a_j = d, so a gap of cutoff lambda is (1 + cutoff lambda) s.
   double range_factor() const { return 1.0 + cutoff * lambda; }
-  bool acts(const PairGeometry& g, bool) const { return gap(g) < cutoff * lambda; }
-  void add_block(const PairGeometry& g, const History&, bool, double dt_implicit,
-                 PairBlock& b) const {
+  template <class Geometry>
+  bool acts(const Geometry& g, bool) const {
+    return gap(g) < cutoff * lambda;
+  }
+  template <class Geometry, class Block>
+  void add_block(const Geometry& g, const History&, bool, double dt_implicit, Block& b) const {
     const double h = gap(g);
     const double f = force(h);
-    const Vec6 m = normal_mode(g);
+    const auto m = normal_mode(g);
     b.add_force(-f * m);
     // Over a step the gap grows by -dt m.U, so F changes by (F / lambda) dt m.U: the force
     // -F m at the end of the step is -F m - dt (F / lambda) m m^T U (none in contact).
@@ -45,8 +51,10 @@ struct DoubleLayerRepulsion {
   }
   bool resistive() const { return false; }
   bool keeps_history() const { return false; }
-  void advance(History&, const PairGeometry&, const Vec6&, double) const {}
-  void cap(History&, const PairGeometry&) const {}
+  template <class Geometry, class PairVelocity>
+  void advance(History&, const Geometry&, const PairVelocity&, double) const {}
+  template <class Geometry>
+  void cap(History&, const Geometry&) const {}
   // Its stiffness is largest at contact, F0 / lambda.
   void add_stability(double, StabilityTerms& s) const { s.normal_stiffness += f0 / lambda; }
   bool needs_rotations() const { return false; }

@@ -1,5 +1,5 @@
 #pragma once
-#include "sheardiff/core/types.hpp"
+#include "sheardiff/core/dimension.hpp"
 
 namespace sheardiff {
 
@@ -9,6 +9,21 @@ struct StokesDrag {
   static Vec3 resistance(double radius) {
     const double d = 2.0 * radius;
     return {3.0 * kPi * d, 3.0 * kPi * d, kPi * d * d * d};
+  }
+  // The same sphere's drag on all three translations and rotations.
+  static Vec6 resistance_3d(double radius) {
+    const double d = 2.0 * radius;
+    Vec6 r;
+    r << 3.0 * kPi * d, 3.0 * kPi * d, 3.0 * kPi * d, kPi * d * d * d, kPi * d * d * d,
+        kPi * d * d * d;
+    return r;
+  }
+  template <class D>
+  static typename D::Body resistance_of(double radius) {
+    if constexpr (D::space == 2)
+      return resistance(radius);
+    else
+      return resistance_3d(radius);
   }
 };
 

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include "sheardiff/core/archive.hpp"
@@ -10,38 +11,59 @@
 namespace sheardiff {
 
 // One listed pair. i is always mobile; j is mobile or a wall particle. j is seen through the
-// periodic image (kx, ky) of the box. Wall-wall pairs are never listed. history: what the pair
-// laws keep for it from step to step (core/pair_history.hpp), carried while the pair touches.
+// periodic image (kx, ky[, kz]) of the box. Wall-wall pairs are never listed. history: what the
+// pair laws keep for it from step to step (core/pair_history.hpp), carried while the pair
+// touches. The 2D record is checkpointed as raw bytes: its layout is fixed.
 struct Pair {
   int i = 0, j = 0;
   int kx = 0, ky = 0;
   PairHistory history;
 };
+struct Pair3 {
+  int i = 0, j = 0;
+  int kx = 0, ky = 0, kz = 0;
+  PairHistory3 history;
+
+  // Field by field: the spring (an Eigen vector) is not trivially copyable.
+  void serialize(Archive& a) {
+    a.io(i), a.io(j), a.io(kx), a.io(ky), a.io(kz);
+    a.io(history.touching), a.io(history.contact.xi), a.io(history.contact.sliding);
+  }
+};
+template <class D>
+using PairOf = std::conditional_t<D::space == 2, Pair, Pair3>;
 
 // The vector from i to (the image of) j of a listed pair, at the current positions and offset.
 inline Vec2 pair_separation(const Particles& p, const Box& box, const Pair& pr) {
   return p.position[pr.j] + box.image_shift(pr.kx, pr.ky) - p.position[pr.i];
+}
+inline Space3 pair_separation(const Particles3& p, const Box3& box, const Pair3& pr) {
+  return p.position[pr.j] + box.image_shift(pr.kx, pr.ky, pr.kz) - p.position[pr.i];
 }
 
 // Verlet list built with a nanoflann k-d tree over the particles and their periodic
 // (and Lees-Edwards shifted) images. Every pair within s (1 + h_max/2) + skin is listed;
 // the list stays valid until the non-affine motion plus the affine shear of a pair can
 // have used up the skin.
-class NeighbourList {
+template <class D>
+class NeighbourListOf {
  public:
-  NeighbourList(double interaction_range_factor, double skin)
+  using Point = typename D::Point;
+  using PairType = PairOf<D>;
+
+  NeighbourListOf(double interaction_range_factor, double skin)
       : range_factor_(interaction_range_factor), skin_(skin) {}
 
   // Wraps positions into the box, rebuilds the list, and carries the history of touching
   // pairs that are still listed.
-  void rebuild(Particles& p, const Box& box);
+  void rebuild(ParticlesOf<D>& p, const BoxOf<D>& box);
   // Accumulate the motion since the last rebuild; na = non-affine displacement of each
   // particle in this step, dstrain = gammadot dt.
-  void advance(const std::vector<Vec2>& na_displacement, double dstrain);
+  void advance(const std::vector<Point>& na_displacement, double dstrain);
   bool needs_rebuild() const;
 
-  const std::vector<Pair>& pairs() const { return pairs_; }
-  std::vector<Pair>& pairs() { return pairs_; }
+  const std::vector<PairType>& pairs() const { return pairs_; }
+  std::vector<PairType>& pairs() { return pairs_; }
   std::size_t rebuilds() const { return rebuilds_; }
   double skin() const { return skin_; }
   void serialize(Archive& a) {
@@ -57,11 +79,14 @@ class NeighbourList {
  private:
   double range_factor_;
   double skin_;
-  std::vector<Pair> pairs_;
-  std::vector<Vec2> na_since_build_;
+  std::vector<PairType> pairs_;
+  std::vector<Point> na_since_build_;
   double strain_since_build_ = 0.0;
   double max_cutoff_ = 0.0;
   std::size_t rebuilds_ = 0;
 };
+
+using NeighbourList = NeighbourListOf<Dim2>;
+using NeighbourList3 = NeighbourListOf<Dim3>;
 
 }  // namespace sheardiff

@@ -34,4 +34,22 @@ struct Scene {
 // The scene cfg asks for, built.
 Scene build_scene(const Config& cfg);
 
+// What a scene of spheres hands to the engine (Dynamics3). No fluid layer: the channel is a disc
+// scene.
+struct Scene3 {
+  Particles3 particles;
+  Box3 box;
+  ImposedFlow flow;
+  std::optional<WallBodies> walls;
+};
+
+// The pressure cell of spheres: particles.N bidisperse spheres (d and particles.size_ratio d,
+// mixed by particles.mix) on a jittered cubic lattice loose enough for the largest (volume
+// fraction ~0.3), between two rough walls of frozen spheres of diameter d (a square lattice in
+// x-z, centres jittered in y by walls.jitter radii), periodic in x and z (lx = lz); the bottom
+// wall is fixed, the top wall floats under P lx lz (P = 1) and is driven at the imposed shear's
+// velocity gammadot = flow.J at its height. The packing compacts under the wall to its
+// steady volume fraction. Reproducible for run.seed.
+Scene3 build_pressure_shear_3d(const Config& cfg);
+
 }  // namespace sheardiff

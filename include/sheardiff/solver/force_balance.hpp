@@ -18,23 +18,30 @@ namespace sheardiff {
 // dt K for implicit springs) and its spring force f; the pair's generalised force is
 // -M U_pair + f with U_pair = (U_i, U_j + image_j), U_j the velocity of particle j itself and
 // image_j the extra velocity of its Lees-Edwards image.
-struct PairTerm {
-  PairGeometry g;
-  Mat6 m = Mat6::Zero();
-  Vec6 f = Vec6::Zero();
-  Vec3 image_j = Vec3::Zero();
+template <class D>
+struct PairTermOf {
+  using Body = typename D::Body;
+  using PairVector = typename D::PairVector;
+  using PairMatrix = typename D::PairMatrix;
+  PairGeometryOf<D> g;
+  PairMatrix m = PairMatrix::Zero();
+  PairVector f = PairVector::Zero();
+  Body image_j = Body::Zero();
   bool on = false;       // some pair law acts on the pair
   bool sliding = false;  // contact at its Coulomb limit at the start of the step
 
-  Vec6 force(const Vec3& ui, const Vec3& uj) const {
-    Vec6 u;
+  PairVector force(const Body& ui, const Body& uj) const {
+    PairVector u;
     u << ui, uj + image_j;
     return f - m * u;
   }
 };
+using PairTerm = PairTermOf<Dim2>;
 
-struct Velocities {
-  std::vector<Vec3> u;          // every particle: mobile solved, wall particles their body's motion
+template <class D>
+struct VelocitiesOf {
+  // every particle: mobile solved, wall particles their body's motion
+  std::vector<typename D::Body> u;
   double wall_v = 0.0;          // y velocity of the floating wall
   bool wall_free_fall = false;  // V was capped: the wall is not (yet) held by the packing
   // With a fluid layer: its deviation from the reference flow at the interior nodes, and the
@@ -42,32 +49,45 @@ struct Velocities {
   std::vector<double> fluid;
   double pressure_gradient = 0.0;
 };
+using Velocities = VelocitiesOf<Dim2>;
 
 // Pair laws + drag -> the linear system -> velocities. One loop over the listed pairs serves
 // every pair law (PairLaws, unrolled at compile time); absent laws cost nothing inside it. The
-// per-pair histories the laws keep are advanced and capped here too.
-class ForceBalance {
+// per-pair histories the laws keep are advanced and capped here too. Discs (D = Dim2) or spheres
+// (Dim3); the fluid layer of a channel is a disc scene's only.
+template <class D>
+class ForceBalanceOf {
  public:
+  using Point = typename D::Point;
+  using Body = typename D::Body;
+  using Particles = ParticlesOf<D>;
+  using Box = BoxOf<D>;
+  using Pair = PairOf<D>;
+  using PairTerm = PairTermOf<D>;
+  using Velocities = VelocitiesOf<D>;
+
   // implicit_springs: the integrator will pass dt_implicit > 0, so contacts couple particles
   // in the matrix even without lubrication.
-  ForceBalance(PairLaws laws, int dof, bool implicit_springs,
-               const std::string& cholesky = "cholmod");
+  ForceBalanceOf(PairLaws laws, int dof, bool implicit_springs,
+                 const std::string& cholesky = "cholmod");
   // Lubrication (or none) and contacts, no other law.
-  ForceBalance(std::optional<Lubrication> lubrication, FrictionalContact contact, int dof,
-               bool implicit_springs, const std::string& cholesky = "cholmod")
-      : ForceBalance(PairLaws(lubrication, contact, std::nullopt), dof, implicit_springs,
-                     cholesky) {}
+  ForceBalanceOf(std::optional<Lubrication> lubrication, FrictionalContact contact, int dof,
+                 bool implicit_springs, const std::string& cholesky = "cholmod")
+      : ForceBalanceOf(PairLaws(lubrication, contact, std::nullopt), dof, implicit_springs,
+                       cholesky) {}
 
   // The fluid of a channel as further unknowns (interactions/fluid_layer.hpp); set before the
   // first on_rebuild.
   void set_fluid(FluidLayer fluid) { fluid_ = std::move(fluid); }
   const std::optional<FluidLayer>& fluid() const { return fluid_; }
-  // The fluid's velocity (v_x, 0, omega) at x: the imposed flow plus the layer's deviation.
-  Vec3 fluid_velocity(const ImposedFlow& flow, const Velocities& v, const Vec2& x) const {
-    Vec3 u = flow.velocity(x);
-    if (fluid_) {
-      u.x() += fluid_->deviation(v.fluid, x.y());
-      u.z() -= 0.5 * fluid_->deviation_slope(v.fluid, x.y());
+  // The fluid's velocity (v, omega) at x: the imposed flow plus the layer's deviation.
+  Body fluid_velocity(const ImposedFlow& flow, const Velocities& v, const Point& x) const {
+    Body u = flow.velocity(x);
+    if constexpr (D::space == 2) {
+      if (fluid_) {
+        u.x() += fluid_->deviation(v.fluid, x.y());
+        u.z() -= 0.5 * fluid_->deviation_slope(v.fluid, x.y());
+      }
     }
     return u;
   }
@@ -90,14 +110,14 @@ class ForceBalance {
   // The laws' per-pair histories over a step of length dt with velocities u, at the positions
   // of its start (call before the move) ...
   void advance_histories(const Particles& p, const Box& box, const ImposedFlow& flow,
-                         std::vector<Pair>& pairs, const std::vector<Vec3>& u, double dt) const;
+                         std::vector<Pair>& pairs, const std::vector<Body>& u, double dt) const;
   // ... and their caps at its end (after the move).
   void cap_histories(const Particles& p, const Box& box, std::vector<Pair>& pairs) const;
   // Implicit springs: contacts that entered the step sliding but whose solved slip unloads
   // their spring stick (FrictionalContact::stick_if_unloading); returns how many changed and
   // their indices into pairs in *switched (optional).
   int stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
-                             const std::vector<Vec3>& u, std::vector<std::size_t>* switched) const;
+                             const std::vector<Body>& u, std::vector<std::size_t>* switched) const;
 
   // Assemble at the current positions and solve. dt_implicit > 0 treats the springs linearly
   // implicitly over a step of that length. walls = nullptr when the scene has none; a floating
@@ -151,6 +171,9 @@ class ForceBalance {
   template <bool kWalls>
   void assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
                       const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls);
+  // Implicit springs: the rows w of a sticking contact's tangential stiffness kt sum w w^T
+  // (one for two discs, two for two spheres).
+  static std::vector<typename D::PairVector> slip_rows(const PairGeometryOf<D>& g);
 
   PairLaws laws_;
   std::optional<FluidLayer> fluid_;
@@ -164,5 +187,8 @@ class ForceBalance {
   bool check_residual_ = false;
   StickingCounts sticking_;
 };
+
+using ForceBalance = ForceBalanceOf<Dim2>;
+using ForceBalance3 = ForceBalanceOf<Dim3>;
 
 }  // namespace sheardiff

@@ -17,7 +17,8 @@ namespace sheardiff {
 // The per-step force/torque balance A U + b V = g of the mobile particles (docs/model.md
 // section 6), with A = drag + sum of pair blocks (+ dt K for implicit springs) symmetric
 // positive definite.
-// Unknowns: `dof` per mobile particle (3 = u_x, u_y, omega; 2 = no rotation), plus the
+// Unknowns: `dof` per mobile particle, the first dof components of its generalised velocity
+// (discs: 3 = u_x, u_y, omega; 2 = no rotation; spheres: 6 = u, omega; 3 = no rotation), plus the
 // optional y velocity V of one floating wall, eliminated by two back-solves on one factor.
 // The sparsity pattern (and the symbolic factorisation) are rebuilt only with the neighbour
 // list: pairs out of range keep their structural zeros.
@@ -35,17 +36,26 @@ class ResistanceSystem final : public SystemEntries {
   // (no lubrication, explicit springs), so A is diagonal and no factorisation is needed.
   // extra_unknowns follow the particles' with the entries extra_entries (row >= col, global
   // indices) in the pattern: the blocks of a fluid layer.
-  void set_pattern(std::size_t n_mobile, const std::vector<Pair>& pairs, const Particles& p,
-                   bool diagonal_only, std::size_t extra_unknowns = 0,
+  template <class D>
+  void set_pattern(std::size_t n_mobile, const std::vector<PairOf<D>>& pairs,
+                   const ParticlesOf<D>& p, bool diagonal_only, std::size_t extra_unknowns = 0,
                    const std::vector<std::pair<int, int>>& extra_entries = {});
 
   void clear();
   // One-body terms: resistance on the diagonal and force on the right-hand side.
-  void add_self(int i, const Vec3& resistance, const Vec3& force);
+  // (Vec3 for a disc, Vec6 for a sphere: its first dof components are unknowns.)
+  void add_self(int i, const Vec3& resistance, const Vec3& force) {
+    add_self_of(i, resistance, force);
+  }
+  void add_self(int i, const Vec6& resistance, const Vec6& force) {
+    add_self_of(i, resistance, force);
+  }
   // Pair k of the list: generalised pair force -M U_pair + f, with U_pair = (U_i, U_j + known_j).
   // j_floating: j belongs to the floating wall, whose y velocity is the extra unknown V.
-  void add_pair(std::size_t k, const Pair& pr, const Mat6& m, const Vec6& f, const Vec3& known_j,
-                bool j_mobile, bool j_floating);
+  // (Mat6, Vec6, Vec3 for two discs; Mat12, Vec12, Vec6 for two spheres.)
+  template <class PairType, class Matrix, class Vector, class Body>
+  void add_pair(std::size_t k, const PairType& pr, const Matrix& m, const Vector& f,
+                const Body& known_j, bool j_mobile, bool j_floating);
 
   // One entry of the matrix (row >= col, in the pattern) and of the right-hand side.
   void add_value(int row, int col, double v) override;
@@ -91,7 +101,8 @@ class ResistanceSystem final : public SystemEntries {
 
  private:
   int index(int row, int col) const;
-  void scatter(int bi, int bj, const Mat6& m, int oi, int oj);
+  template <class Body>
+  void add_self_of(int i, const Body& resistance, const Body& force);
 
   int dof_;
   std::size_t n_ = 0, extra_ = 0;

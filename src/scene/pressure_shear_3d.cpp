@@ -1,0 +1,86 @@
+// The pressure cell of spheres (scene/scene.hpp): a loose lattice of bidisperse spheres between
+// two rough walls of frozen spheres, periodic in x and z.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "sheardiff/scene/scene.hpp"
+#include "sheardiff/setup/random_packing.hpp"
+
+namespace sheardiff {
+
+namespace {
+
+// One rough wall: spheres of diameter 1 on a square lattice filling lx x lz (squeezed a little
+// where lx is not a whole number of diameters), centres at base + side (a + jitter a u), u in
+// [0, 1).
+void add_wall(Particles3& p, std::vector<int>& ids, double l, double base, int side, double jitter,
+              Motion motion, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  const int per_side = std::max(1, static_cast<int>(std::floor(l)));
+  const double spacing = l / per_side, a = 0.5;
+  for (int ix = 0; ix < per_side; ++ix)
+    for (int iz = 0; iz < per_side; ++iz) {
+      const std::size_t k = p.size();
+      p.resize(k + 1);
+      p.position[k] = Space3((ix + 0.5) * spacing, base + side * (a + jitter * a * uni(rng)),
+                             (iz + 0.5) * spacing);
+      p.radius[k] = a;
+      p.motion[k] = motion;
+      ids.push_back(static_cast<int>(k));
+    }
+}
+
+}  // namespace
+
+Scene3 build_pressure_shear_3d(const Config& cfg) {
+  const std::int64_t n = cfg.particles.n;
+  const double ratio = cfg.particles.size_ratio;
+  std::vector<int> species = bidisperse_species(n, cfg.particles.mix, ratio);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
+  std::shuffle(species.begin(), species.end(), rng);
+  // Lattice sites one largest diameter plus a margin apart, per_side x per_side in x-z and as
+  // many layers in y as it takes; each centre jittered by up to 0.02 spacing per axis, so that
+  // no two spheres touch (1.5 - 0.06 > 1.4 at the default size ratio).
+  const double spacing = std::max(1.0, ratio) + 0.1;
+  const int per_side =
+      std::max(2, static_cast<int>(std::lround(std::cbrt(static_cast<double>(n)))));
+  const auto layers = static_cast<int>((n + per_side * per_side - 1) / (per_side * per_side));
+  const double l = per_side * spacing;
+  std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+
+  Scene3 sc;
+  Particles3& p = sc.particles;
+  p.resize(static_cast<std::size_t>(n));
+  p.n_mobile = static_cast<std::size_t>(n);
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto site = static_cast<int>(k);
+    const int layer = site / (per_side * per_side), ix = (site / per_side) % per_side,
+              iz = site % per_side;
+    p.position[k] =
+        Space3((ix + 0.5 + jitter(rng)) * spacing, (layer + 1.0 + jitter(rng)) * spacing,
+               (iz + 0.5 + jitter(rng)) * spacing);
+    p.species[k] = species[k];
+    p.radius[k] = species[k] == 1 ? 0.5 * ratio : 0.5;
+  }
+  // The lowest layer sits one spacing above the bottom wall's surface (y = 0), the top wall one
+  // spacing above the highest layer.
+  WallBodies walls;
+  walls.top_role = WallRole::Floating;
+  const double top = (layers + 1.0) * spacing;
+  add_wall(p, walls.bottom, l, 0.0, -1, cfg.walls.jitter, Motion::FixedWall, rng);
+  add_wall(p, walls.top, l, top, +1, cfg.walls.jitter, Motion::FloatingWall, rng);
+  p.unwrapped = p.position;
+  walls.load = 1.0 * l * l;  // P lx lz with P = 1
+  walls.free_fall_cap = cfg.walls.free_fall_speed;
+
+  sc.box.lx = sc.box.lz = l;
+  sc.box.ly = top + 2.0;  // extent at the start; not periodic in y
+  sc.box.lees_edwards = false;
+  sc.flow.gammadot = cfg.flow.j;
+  sc.flow.y0 = mean_height(p, walls.bottom);
+  sc.walls = std::move(walls);
+  return sc;
+}
+
+}  // namespace sheardiff

@@ -1,0 +1,204 @@
+// Stepping spheres (Dynamics3 and the integrators instantiated in three dimensions): a sphere
+// pressed on a wall sphere settles at the overlap F / kn; spheres whose centres lie in one plane
+// step exactly as the discs of the same configuration; and in a pressure cell of spheres between
+// rough walls of frozen spheres, the suspension pushes on the floating top wall with exactly
+// P Lx Lz at every step once the wall rests on it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "sheardiff/config.hpp"
+#include "sheardiff/engine.hpp"
+#include "sheardiff/integrator/integrators.hpp"
+#include "sheardiff/integrator/stress.hpp"
+#include "sheardiff/scene/scene.hpp"
+#include "spheres_in_a_plane.hpp"
+
+namespace sheardiff {
+namespace {
+
+Dynamics3 make_dynamics(const Config& cfg, Particles3 p, const Box3& box, const ImposedFlow& flow,
+                        std::optional<WallBodies> walls, bool implicit) {
+  ForceBalance3 fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 6 : 3, implicit);
+  return Dynamics3(std::move(p), box, flow, std::move(fb),
+                   NeighbourList3(interaction_range_factor(cfg), cfg.neighbour.skin),
+                   step_limits(cfg, flow.clock_rate(), implicit), std::move(walls));
+}
+
+TEST(SphereDynamics, SpherePressedOnAWallSphereSettlesAtTheOverlapFOverKn) {
+  Config cfg;
+  cfg.contact.ktilde = 1e4;
+  const double a = 0.5, force = 2.0;
+  const Space3 n = Space3(-0.2, 1.0, 0.6).normalized();
+  Particles3 p;
+  p.resize(2);
+  p.n_mobile = 1;
+  p.position = {Space3(3.0, 3.0, 3.0), Space3(3.0, 3.0, 3.0) + 1.02 * n};
+  p.unwrapped = p.position;
+  p.radius = {a, a};
+  p.motion[1] = Motion::FixedWall;
+  Vec6 push = Vec6::Zero();
+  push.head<3>() = force * n;
+  p.external = {push, Vec6::Zero()};
+  Box3 box;
+  box.lx = box.ly = box.lz = 8.0;
+  WallBodies walls;
+  walls.bottom = {1};
+  walls.top_role = WallRole::Fixed;
+  for (const IntegratorType type : {IntegratorType::Implicit, IntegratorType::Euler}) {
+    Dynamics3 d =
+        make_dynamics(cfg, p, box, ImposedFlow{0.0, 0.0}, walls, type == IntegratorType::Implicit);
+    auto integrator = make_integrator_of<Dim3>(type);
+    // Without a flow nothing bounds an implicit step but its growth (1.25 per step): 50 steps
+    // take it from the approach (dt ~ 0.03) to rest (dt ~ 50, thousands of the spring's
+    // relaxation time (zeta + XA_0) / kn = 0.025). Explicit springs stay at their stability
+    // limit: 3000 steps.
+    const int steps = type == IntegratorType::Implicit ? 50 : 3000;
+    for (int s = 0; s < steps; ++s) ASSERT_TRUE(integrator->step(d));
+    const Space3 r = d.particles().position[1] - d.particles().position[0];
+    // The rest state is exact: 1e-6 of the overlap is a settled contact, a wrong spring scale is
+    // O(1).
+    EXPECT_NEAR((2.0 * a - r.norm()) / (force / cfg.contact.ktilde), 1.0, 1e-6) << to_string(type);
+    // Pressed along the line of centres, it neither slides off nor turns.
+    EXPECT_LT((r.normalized() - n).norm(), 1e-9) << to_string(type);
+    EXPECT_LT(d.particles().velocity[0].tail<3>().norm(), 1e-9) << to_string(type);
+  }
+}
+
+using testing_3d::lift;
+
+TEST(SphereDynamics, SpheresInOnePlaneStepAsTheDiscs) {
+  // Forty implicit steps of a sheared dense packing from its start (no contact history yet) in
+  // two and three dimensions: the same step sizes and, to round-off grown over the steps, the
+  // same positions, contacts opening and springs loading alike; the spheres never leave their
+  // plane.
+  Config cfg;
+  cfg.particles.n = 200;
+  cfg.particles.phi_init = 0.78;
+  cfg.flow.j = 1e-2;
+  cfg.contact.ktilde = 1e4;
+  Simulation sim(cfg);
+  Dynamics& d2 = sim.dynamics();
+  const double lz = 40.0;
+  Box3 box;
+  static_cast<Box&>(box) = d2.box();
+  box.lz = lz;
+  Dynamics3 d3 =
+      make_dynamics(cfg, lift(d2.particles(), 0.5 * lz), box, d2.flow(), std::nullopt, true);
+  ASSERT_EQ(d3.neighbours().pairs().size(), d2.neighbours().pairs().size());
+  auto i2 = make_integrator(IntegratorType::Implicit);
+  auto i3 = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  for (int s = 0; s < 40; ++s) {
+    ASSERT_TRUE(i2->step(d2));
+    ASSERT_TRUE(i3->step(d3));
+    EXPECT_NEAR(i3->last_dt(), i2->last_dt(), 1e-9 * i2->last_dt()) << "step " << s;
+  }
+  int contacts = 0, loaded = 0;
+  for (const Pair& pr : d2.neighbours().pairs()) {
+    contacts += pr.history.touching ? 1 : 0;
+    loaded += pr.history.contact.xi != 0.0 ? 1 : 0;
+  }
+  ASSERT_GT(contacts, 20) << "the test needs a packing with contacts";
+  ASSERT_GT(loaded, 10) << "the test needs loaded tangential springs";
+  double worst = 0.0, off = 0.0;
+  for (std::size_t i = 0; i < d2.particles().size(); ++i) {
+    const Space3& x3 = d3.particles().unwrapped[i];
+    const Vec2& x2 = d2.particles().unwrapped[i];
+    worst = std::max(worst, (Vec2(x3.x(), x3.y()) - x2).norm());
+    off = std::max(off, std::abs(x3.z() - 0.5 * lz));
+  }
+  // Positions of order 10 d after 40 steps of ~1e-3 d: round-off of the solves (1e-13 relative)
+  // grows little over so few steps; 1e-9 d is far below a step and far above round-off.
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(off, 1e-12);
+}
+
+// The pressure cell of spheres (scene/pressure_shear_3d.cpp): 48 spheres, 4 x 4 x 3 on the
+// loose lattice, between walls of 6 x 6 spheres.
+Scene3 sphere_cell(const Config& cfg) {
+  Config c = cfg;
+  c.particles.n = 48;
+  return build_pressure_shear_3d(c);
+}
+
+TEST(SphereDynamics, PressureCellWallForceEqualsPLxLzEveryStep) {
+  Config cfg;
+  cfg.flow.j = 1e-2;
+  cfg.contact.ktilde = 1e4;
+  cfg.run.seed = 11;
+  Scene3 cell = sphere_cell(cfg);
+  Dynamics3 d = make_dynamics(cfg, cell.particles, cell.box, cell.flow, cell.walls, true);
+  auto integrator = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  // The top wall falls onto the packing, which compacts under it until its contacts carry the
+  // load (on average one contact per sphere or more, the wall held for 200 steps).
+  const auto n_mobile = static_cast<int>(d.particles().n_mobile);
+  int held = 0, contacts = 0, s = 0;
+  for (; s < 40000 && (held < 200 || contacts < n_mobile); ++s) {
+    ASSERT_TRUE(integrator->step(d));
+    held = integrator->velocities().wall_free_fall ? 0 : held + 1;
+    contacts = integrator->sample(d, 1.0).contacts;
+  }
+  ASSERT_TRUE(held >= 200 && contacts >= n_mobile)
+      << "the packing did not come to carry the wall: " << contacts << " contacts after " << s
+      << " steps";
+  RecordProperty("compaction_steps", s);
+  const double load = cell.box.lx * cell.box.lz;
+  for (s = 0; s < 100; ++s) {
+    ASSERT_TRUE(integrator->step(d));
+    ASSERT_FALSE(integrator->velocities().wall_free_fall) << "step " << s;
+    const StressSample sample = integrator->sample(d, 1.0);
+    // The wall's y balance is one row of the solved system: round-off only.
+    ASSERT_NEAR(sample.top_wall_fy / load, 1.0, 1e-9) << "step " << s;
+  }
+  // The suspension is sheared: the top wall moves at gammadot times its height in x (taken at
+  // the start of the step; the wall has moved by V dt in y since).
+  EXPECT_NEAR(d.wall_bodies()->driven_vx / (cfg.flow.j * d.height()), 1.0, 1e-3);
+}
+
+TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
+  // Implicit springs: a sliding contact whose solved slip unloads its spring sticks, and the step
+  // is solved again with its tangential stiffness dt kt W^T W added as two low-rank terms per
+  // contact on the old factor. A fresh assembly and factorisation with those contacts sticking
+  // must give the same velocities. Found in the sheared pressure cell of spheres.
+  Config cfg;
+  cfg.flow.j = 1e-2;
+  cfg.contact.ktilde = 1e4;
+  cfg.run.seed = 5;
+  Scene3 cell = sphere_cell(cfg);
+  Dynamics3 d = make_dynamics(cfg, cell.particles, cell.box, cell.flow, cell.walls, true);
+  auto integrator = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  std::vector<std::size_t> switched;
+  for (int s = 0; s < 20000; ++s) {
+    ASSERT_TRUE(integrator->step(d));
+    if (s < 500) continue;
+    const double dt = integrator->last_dt();
+    d.begin_step();
+    VelocitiesOf<Dim3> low_rank, fresh;
+    ASSERT_TRUE(d.solve(dt, low_rank));
+    if (d.stick_reversed_sliding(low_rank, &switched) == 0) continue;
+    bool wall = false;
+    for (std::size_t k : switched)
+      wall = wall || d.particles().motion[d.neighbours().pairs()[k].j] == Motion::FloatingWall;
+    if (wall) continue;  // those refactorise anyway
+    const long before = d.force_balance().sticking_counts().low_rank;
+    ASSERT_TRUE(d.resolve_with_sticking(dt, switched, low_rank));
+    ASSERT_EQ(d.force_balance().sticking_counts().low_rank, before + 1);
+    ASSERT_TRUE(d.solve(dt, fresh));
+    double scale = 0.0, worst = 0.0;
+    for (std::size_t i = 0; i < d.particles().n_mobile; ++i) {
+      scale = std::max(scale, fresh.u[i].cwiseAbs().maxCoeff());
+      worst = std::max(worst, (low_rank.u[i] - fresh.u[i]).cwiseAbs().maxCoeff());
+    }
+    // Woodbury on a well-conditioned factor: round-off; a missing row is O(1) on the contact.
+    EXPECT_LT(worst, 1e-9 * scale) << switched.size() << " contacts switched at step " << s;
+    EXPECT_NEAR(low_rank.wall_v, fresh.wall_v, 1e-9 * scale);
+    return;
+  }
+  FAIL() << "no sliding contact stuck in 20000 steps";
+}
+
+}  // namespace
+}  // namespace sheardiff
