@@ -88,10 +88,11 @@ std::string run_result_details(const nlohmann::json& summary) {
         return std::isfinite(e) ? fmt::format(" +- {:.2g}", e) : std::string(" (no error bar)");
       };
       details += fmt::format(
-          "  steady from strain {:.3g}: phi = {:.4f}{}, mu = {:.4f}{}, H = {:.3f} d ({})\n",
-          num(summary, summary_key::steady_strain), num(summary, summary_key::phi),
-          pm(summary_key::phi_err), num(summary, summary_key::mu), pm(summary_key::mu_err),
-          num(summary, summary_key::H),
+          "  steady at strain {:.4g}, measured over {:.3g} strains: phi = {:.4f}{}, mu = {:.4f}{}, "
+          "H = {:.3f} d ({})\n",
+          num(summary, summary_key::steady_detected_at), num(summary, summary_key::measured_strain),
+          num(summary, summary_key::phi), pm(summary_key::phi_err), num(summary, summary_key::mu),
+          pm(summary_key::mu_err), num(summary, summary_key::H),
           summary.contains(summary_key::steady_errors_note)
               ? summary[summary_key::steady_errors_note].get<std::string>()
               : std::string("+- statistical errors, time blocks"));

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -116,22 +117,34 @@ TEST(SphereDynamics, SpheresInOnePlaneStepAsTheDiscs) {
   EXPECT_LT(off, 1e-12);
 }
 
-// The pressure cell of spheres (scene/pressure_shear_3d.cpp): 48 spheres, 4 x 4 x 3 on the
-// loose lattice, between walls of 6 x 6 spheres.
-Scene3 sphere_cell(const Config& cfg) {
-  Config c = cfg;
-  c.particles.n = 48;
-  return build_pressure_shear_3d(c);
-}
+// The pressure cell of spheres (scene/pressure_shear_3d.cpp) at J = 1e-2, ktilde = 1e4, with
+// implicit springs: 48 spheres, 4 x 4 x 3 on the loose lattice, between walls of 6 x 6 spheres.
+struct SphereCell {
+  Config cfg;
+  Scene3 scene;
+  Dynamics3 dynamics;
+  std::unique_ptr<IntegratorOf<Dim3>> integrator;
+
+  explicit SphereCell(std::int64_t seed)
+      : cfg(cell_config(seed)),
+        scene(build_pressure_shear_3d(cfg)),
+        dynamics(make_dynamics(cfg, scene.particles, scene.box, scene.flow, scene.walls, true)),
+        integrator(make_integrator_of<Dim3>(IntegratorType::Implicit)) {}
+
+  static Config cell_config(std::int64_t seed) {
+    Config c;
+    c.particles.n = 48;
+    c.flow.j = 1e-2;
+    c.contact.ktilde = 1e4;
+    c.run.seed = seed;
+    return c;
+  }
+};
 
 TEST(SphereDynamics, PressureCellWallForceEqualsPLxLzEveryStep) {
-  Config cfg;
-  cfg.flow.j = 1e-2;
-  cfg.contact.ktilde = 1e4;
-  cfg.run.seed = 11;
-  Scene3 cell = sphere_cell(cfg);
-  Dynamics3 d = make_dynamics(cfg, cell.particles, cell.box, cell.flow, cell.walls, true);
-  auto integrator = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  SphereCell cell(11);
+  Dynamics3& d = cell.dynamics;
+  auto& integrator = cell.integrator;
   // The top wall falls onto the packing, which compacts under it until its contacts carry the
   // load (on average one contact per sphere or more, the wall held for 200 steps).
   const auto n_mobile = static_cast<int>(d.particles().n_mobile);
@@ -145,7 +158,7 @@ TEST(SphereDynamics, PressureCellWallForceEqualsPLxLzEveryStep) {
       << "the packing did not come to carry the wall: " << contacts << " contacts after " << s
       << " steps";
   RecordProperty("compaction_steps", s);
-  const double load = cell.box.lx * cell.box.lz;
+  const double load = d.box().lx * d.box().lz;
   for (s = 0; s < 100; ++s) {
     ASSERT_TRUE(integrator->step(d));
     ASSERT_FALSE(integrator->velocities().wall_free_fall) << "step " << s;
@@ -155,7 +168,7 @@ TEST(SphereDynamics, PressureCellWallForceEqualsPLxLzEveryStep) {
   }
   // The suspension is sheared: the top wall moves at gammadot times its height in x (taken at
   // the start of the step; the wall has moved by V dt in y since).
-  EXPECT_NEAR(d.wall_bodies()->driven_vx / (cfg.flow.j * d.height()), 1.0, 1e-3);
+  EXPECT_NEAR(d.wall_bodies()->driven_vx / (cell.cfg.flow.j * d.height()), 1.0, 1e-3);
 }
 
 TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
@@ -163,13 +176,9 @@ TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
   // is solved again with its tangential stiffness dt kt W^T W added as two low-rank terms per
   // contact on the old factor. A fresh assembly and factorisation with those contacts sticking
   // must give the same velocities. Found in the sheared pressure cell of spheres.
-  Config cfg;
-  cfg.flow.j = 1e-2;
-  cfg.contact.ktilde = 1e4;
-  cfg.run.seed = 5;
-  Scene3 cell = sphere_cell(cfg);
-  Dynamics3 d = make_dynamics(cfg, cell.particles, cell.box, cell.flow, cell.walls, true);
-  auto integrator = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  SphereCell cell(5);
+  Dynamics3& d = cell.dynamics;
+  auto& integrator = cell.integrator;
   std::vector<std::size_t> switched;
   for (int s = 0; s < 20000; ++s) {
     ASSERT_TRUE(integrator->step(d));
