@@ -170,6 +170,11 @@ const std::vector<KeySpec>& schema() {
     s.push_back(choice(
         "scene.type", scenes, scene_doc + ".", [](const C& c) { return Value{c.scene.type}; },
         [](C& c, const Value& v) { c.scene.type = std::get<std::string>(v); }));
+    s.push_back(integer("scene.dimension", &C::scene, &C::Scene::dimension, 2, 3, "",
+                        "2: discs in a monolayer of thickness flow.lz (the seed's set-up); 3: "
+                        "spheres, periodic in z (docs/model.md, \"Three dimensions\"; the scenes "
+                        "that have one: " +
+                            scenes_of_spheres() + ")."));
     s.push_back(integer("particles.N", &C::particles, &C::ParticlesCfg::n, 2, 1e6, "",
                         "Number of mobile particles."));
     s.push_back(choice(
@@ -476,7 +481,25 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
   }
 }
 
+// Spheres: a scene that has them, placed by its own builder, written without a trajectory
+// (its writer is of discs).
+void check_spheres(const Config& c, const std::string& origin) {
+  if (c.scene.dimension != 3) return;
+  if (!scene_kind(c.scene.type).spheres)
+    fail(origin, "scene.dimension",
+         fmt::format("3 (spheres) is allowed for scene.type = {}, not \"{}\"", scenes_of_spheres(),
+                     c.scene.type));
+  if (!c.particles.init_file.empty())
+    fail(origin, "particles.init_file",
+         "a scene of spheres (scene.dimension = 3) places its own spheres; leave it empty");
+  if (c.output.trajectory)
+    fail(origin, "output.trajectory",
+         "a scene of spheres (scene.dimension = 3) has no trajectory writer yet; set "
+         "output.trajectory = false (the diffusion analysis streams without it)");
+}
+
 void check_combinations(const Config& c, const std::string& origin) {
+  check_spheres(c, origin);
   if (const auto check = scene_kind(c.scene.type).check)
     if (const std::optional<ConfigProblem> problem = check(c))
       fail(origin, problem->key, problem->message);

@@ -52,6 +52,10 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
     } catch (const std::exception& e) {
       throw ConfigError(fmt::format("{}: particles.init_file: {}", origin, e.what()));
     }
+  } else if (cfg.scene.dimension == 3 && scene_kind(cfg.scene.type).planned_cell_3d) {
+    // Periodic in x and z: the narrower edge counts.
+    const PlannedCell cell = scene_kind(cfg.scene.type).planned_cell_3d(cfg);
+    lx = std::min(cell.lx, cell.lz), ly = cell.ly;
   } else if (const auto planned = scene_kind(cfg.scene.type).planned_cell) {
     const PlannedCell cell = planned(cfg);
     lx = cell.lx, ly = cell.ly;
@@ -96,27 +100,52 @@ StepLimits step_limits(const Config& cfg, double clock_rate, bool implicit_sprin
   return lim;
 }
 
-Simulation::Simulation(const Config& cfg) : Simulation(cfg, build_scene(cfg)) {}
-
-Simulation::Simulation(const Config& cfg, Scene scene)
-    : cfg_(cfg), integrator_(make_integrator(cfg.integrator.type)) {
-  const StepLimits lim = step_limits(cfg, scene.flow.clock_rate(), integrator_->implicit_springs());
-  const double range = interaction_range_factor(cfg);
-  ForceBalance fb(PairLaws::from(cfg), rotational_unknowns(cfg) ? 3 : 2,
-                  integrator_->implicit_springs(), cfg.solver.cholesky);
-  if (const auto& g = scene.fluid)
-    fb.set_fluid(FluidLayer(g->y_lo, g->y_hi, g->cells, g->lx, g->lz, g->reach));
-  dynamics_ = std::make_unique<Dynamics>(std::move(scene.particles), scene.box, scene.flow,
-                                         std::move(fb), NeighbourList(range, cfg.neighbour.skin),
-                                         lim, std::move(scene.walls));
+template <>
+Scene build_scene_of<Dim2>(const Config& cfg) {
+  return build_scene(cfg);
 }
 
-void Simulation::step() {
+template <>
+Scene3 build_scene_of<Dim3>(const Config& cfg) {
+  const auto build = scene_kind(cfg.scene.type).build_3d;
+  if (build == nullptr)
+    throw ConfigError(fmt::format(
+        "scene.dimension: scene.type = \"{}\" has no scene of spheres; scene.dimension = 3 is "
+        "allowed for {}",
+        cfg.scene.type, scenes_of_spheres()));
+  return build(cfg);
+}
+
+template <class D>
+SimulationOf<D>::SimulationOf(const Config& cfg) : SimulationOf(cfg, build_scene_of<D>(cfg)) {}
+
+template <class D>
+SimulationOf<D>::SimulationOf(const Config& cfg, SceneOf<D> scene)
+    : cfg_(cfg), integrator_(make_integrator_of<D>(cfg.integrator.type)) {
+  const StepLimits lim = step_limits(cfg, scene.flow.clock_rate(), integrator_->implicit_springs());
+  const double range = interaction_range_factor(cfg);
+  const bool rotations = rotational_unknowns(cfg);
+  ForceBalanceOf<D> fb(PairLaws::from(cfg), rotations ? D::body : D::space,
+                       integrator_->implicit_springs(), cfg.solver.cholesky);
+  if constexpr (D::space == 2) {
+    if (const auto& g = scene.fluid)
+      fb.set_fluid(FluidLayer(g->y_lo, g->y_hi, g->cells, g->lx, g->lz, g->reach));
+  }
+  dynamics_ = std::make_unique<Dynamics>(
+      std::move(scene.particles), scene.box, scene.flow, std::move(fb),
+      NeighbourListOf<D>(range, cfg.neighbour.skin), lim, std::move(scene.walls));
+}
+
+template <class D>
+void SimulationOf<D>::step() {
   if (!integrator_->step(*dynamics_))
     throw std::runtime_error(fmt::format(
         "linear solve failed at step {} (strain {:.6g}): the resistance matrix is not positive "
         "definite or the velocities are not finite",
         dynamics_->steps(), dynamics_->strain()));
 }
+
+template class SimulationOf<Dim2>;
+template class SimulationOf<Dim3>;
 
 }  // namespace sheardiff

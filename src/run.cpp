@@ -280,9 +280,10 @@ void claim_directory(RunDirectory& dir, RunMode mode, bool from_checkpoint, bool
 // The end of the run. Every write replaces what an earlier attempt may have written (tables,
 // analysis.h5, summary.json), so a death anywhere in it resumes from the last checkpoint and
 // completes; summary.json, written last, marks the run finished.
-nlohmann::json finish_run(const Config& cfg, RunningState& run, double elapsed_now,
-                          RunDirectory& dir, TrajectoryOutput& trajectory,
-                          const CheckpointStore& checkpoints) {
+template <class D>
+nlohmann::json finish_run(const Config& cfg, RunningStateOf<D>& run, double elapsed_now,
+                          RunDirectory& dir, TrajectoryOutputOf<D>& trajectory,
+                          const CheckpointStoreOf<D>& checkpoints) {
   nlohmann::json js = run_summary(cfg, run, run.elapsed_before + elapsed_now, dir, trajectory);
   // The state at the end, kept so that the run can be extended (written before the summary:
   // a finished run always has it).
@@ -319,10 +320,11 @@ namespace {
 
 // A finished run's end state, read to extend it: an unreadable one leaves the finished run as it
 // is (the advice to start again with --overwrite, right for a checkpoint, would delete it).
-void load_final_state(RunningState& run, CheckpointPayload payload, const RunDirectory& dir,
+template <class D>
+void load_final_state(RunningStateOf<D>& run, CheckpointPayload payload, const RunDirectory& dir,
                       const std::string& resolved) {
   try {
-    CheckpointStore(dir.file(kFinalStateFile), resolved, dir.path().string())
+    CheckpointStoreOf<D>(dir.file(kFinalStateFile), resolved, dir.path().string())
         .load(run, std::move(payload));
   } catch (const CorruptCheckpoint& e) {
     throw CorruptCheckpoint(
@@ -333,7 +335,8 @@ void load_final_state(RunningState& run, CheckpointPayload payload, const RunDir
 
 // An extension goes on from where the run is; a finished run's results are set aside first
 // (refused, with nothing changed, when the new end is no further than where the run stopped).
-std::string extension_note(const Config& cfg, const RunningState& run, RunDirectory& dir,
+template <class D>
+std::string extension_note(const Config& cfg, const RunningStateOf<D>& run, RunDirectory& dir,
                            bool finished) {
   const double strain = run.sim.dynamics().strain();
   if (run.finished(cfg))
@@ -373,10 +376,15 @@ namespace {
 
 // Where a run's step loop sends what it produces: checkpoints, frames, progress lines; and how
 // it stops (a signal, an unhealthy state) with a checkpoint.
+template <class D>
 class StepLoop {
  public:
-  StepLoop(const Config& cfg, RunningState& run, RunDirectory& dir,
-           const CheckpointStore& checkpoints, TrajectoryOutput& trajectory, RunProgress& progress)
+  using Dynamics = DynamicsOf<D>;
+  using StepView = StepViewOf<D>;
+
+  StepLoop(const Config& cfg, RunningStateOf<D>& run, RunDirectory& dir,
+           const CheckpointStoreOf<D>& checkpoints, TrajectoryOutputOf<D>& trajectory,
+           RunProgress& progress)
       : cfg_(cfg),
         run_(run),
         dir_(dir),
@@ -385,7 +393,7 @@ class StepLoop {
         progress_(progress) {}
 
   void run_to_the_end() {
-    Simulation& sim = run_.sim;
+    auto& sim = run_.sim;
     Dynamics& d = sim.dynamics();
     if (d.steps() == 0 && run_.frames == 0) frame_at_rest();
     while (!run_.finished(cfg_)) {
@@ -398,7 +406,7 @@ class StepLoop {
       const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
       for (const auto& o : run_.observers) o->on_step(view);
       if (d.strain() >= run_.next_frame * (1.0 - 1e-12)) output_frame(view);
-      progress_.update(cfg_, run_);
+      show_progress();
       trajectory_.flush_now_and_then();
     }
     // The last move may have used up the skin: check it against a fresh neighbour list.
@@ -414,7 +422,7 @@ class StepLoop {
   // The frame at step 0: the initial configuration with its velocities and stresses at rest
   // (solved, nothing moved). Observers give its values; none takes it as a sample of the flow.
   void frame_at_rest() {
-    Simulation& sim = run_.sim;
+    auto& sim = run_.sim;
     if (!sim.solve_at_rest())
       stop(run_.health.solver_failure(sim.dynamics(), sim.integrator().velocities()));
     const StressSample s = sim.sample_at_rest();
@@ -460,11 +468,19 @@ class StepLoop {
     throw RunUnhealthy(r);
   }
 
+  void show_progress() {
+    const Dynamics& d = run_.sim.dynamics();
+    std::string more;
+    for (const auto& o : run_.observers)
+      if (const std::string words = o->progress(); !words.empty()) more += "  " + words;
+    progress_.update(d.strain(), d.steps(), run_.planned_end_strain(cfg_), more);
+  }
+
   const Config& cfg_;
-  RunningState& run_;
+  RunningStateOf<D>& run_;
   RunDirectory& dir_;
-  const CheckpointStore& checkpoints_;
-  TrajectoryOutput& trajectory_;
+  const CheckpointStoreOf<D>& checkpoints_;
+  TrajectoryOutputOf<D>& trajectory_;
   RunProgress& progress_;
   std::vector<double> values_;
 };
@@ -493,6 +509,35 @@ class StepLoop {
                         out)));
 }
 
+// The run in its dimension, from where check_directory found it to its end.
+template <class D>
+nlohmann::json run_in(const Config& cfg, RunDirectory& dir, RunMode mode, Origin origin,
+                      bool extending, const std::string& resolved, std::int64_t started,
+                      bool progress, double progress_seconds) {
+  const bool from_checkpoint = origin == Origin::checkpoint || origin == Origin::final_state;
+  const CheckpointStoreOf<D> checkpoints(dir.file("checkpoint.bin"), resolved, dir.path().string());
+  CheckpointPayload payload;
+  if (from_checkpoint)
+    payload = read_checkpoint_file(
+        dir.file(origin == Origin::final_state ? kFinalStateFile : kCheckpointFile));
+  // The initial state is built (and the checkpoint read) before anything is written: a bad
+  // input file leaves no output.
+  const bool checksummed = payload.checksummed;
+  RunningStateOf<D> run(cfg, dir.path(), started);
+  if (origin == Origin::final_state)
+    load_final_state(run, std::move(payload), dir, resolved);
+  else if (from_checkpoint)
+    checkpoints.load(run, std::move(payload));
+  const std::string extension =
+      extending ? extension_note(cfg, run, dir, origin == Origin::final_state) : "";
+  claim_directory(dir, mode, from_checkpoint, checksummed, resolved, extension);
+  TrajectoryOutputOf<D> trajectory(cfg, run, dir, resolved, from_checkpoint);
+  RunProgress progress_lines(dir, progress, progress_seconds, run.sim.dynamics().strain(),
+                             run.sim.dynamics().steps());
+  StepLoop<D>(cfg, run, dir, checkpoints, trajectory, progress_lines).run_to_the_end();
+  return finish_run(cfg, run, progress_lines.elapsed(), dir, trajectory, checkpoints);
+}
+
 }  // namespace
 
 nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode mode, bool progress,
@@ -507,27 +552,10 @@ nlohmann::json run_to_directory(const Config& given, RunDirectory& dir, RunMode 
   bool extending = false;
   const Origin origin = check_directory(dir, mode, cfg, resolved, extending);
   if (origin == Origin::finished) return finished_run_summary(dir);
-  const bool from_checkpoint = origin == Origin::checkpoint || origin == Origin::final_state;
-  const CheckpointStore checkpoints(dir.file("checkpoint.bin"), resolved, dir.path().string());
-  CheckpointPayload payload;
-  if (from_checkpoint)
-    payload = read_checkpoint_file(
-        dir.file(origin == Origin::final_state ? kFinalStateFile : kCheckpointFile));
-  // The initial state is built (and the checkpoint read) before anything is written: a bad
-  // input file leaves no output.
-  const bool checksummed = payload.checksummed;
-  RunningState run(cfg, dir.path(), started);
-  if (origin == Origin::final_state)
-    load_final_state(run, std::move(payload), dir, resolved);
-  else if (from_checkpoint)
-    checkpoints.load(run, std::move(payload));
-  const std::string extension =
-      extending ? extension_note(cfg, run, dir, origin == Origin::final_state) : "";
-  claim_directory(dir, mode, from_checkpoint, checksummed, resolved, extension);
-  TrajectoryOutput trajectory(cfg, run, dir, resolved, from_checkpoint);
-  RunProgress progress_lines(dir, progress, progress_seconds, run.sim.dynamics());
-  StepLoop(cfg, run, dir, checkpoints, trajectory, progress_lines).run_to_the_end();
-  return finish_run(cfg, run, progress_lines.elapsed(), dir, trajectory, checkpoints);
+  return cfg.scene.dimension == 3 ? run_in<Dim3>(cfg, dir, mode, origin, extending, resolved,
+                                                 started, progress, progress_seconds)
+                                  : run_in<Dim2>(cfg, dir, mode, origin, extending, resolved,
+                                                 started, progress, progress_seconds);
 } catch (const IoError& e) {
   if (!dir.logging()) throw;
   rethrow_with_advice(dir, e);

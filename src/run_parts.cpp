@@ -47,11 +47,12 @@ bool same_config_text(const std::string& text, const std::string& resolved) {
 
 // ---- RunningState --------------------------------------------------------------------------
 
-RunningState::RunningState(const Config& cfg, const std::filesystem::path& out_dir,
-                           std::int64_t started_at)
+template <class D>
+RunningStateOf<D>::RunningStateOf(const Config& cfg, const std::filesystem::path& out_dir,
+                                  std::int64_t started_at)
     : sim(cfg),
       health(cfg, sim.dynamics()),
-      observers(make_observers(cfg, out_dir)),
+      observers(make_observers_of<D>(scene_kind(cfg.scene.type), cfg, out_dir)),
       next_frame(cfg.output.frame_strain),
       next_checkpoint(cfg.output.checkpoint_strain),
       started(started_at) {
@@ -59,15 +60,17 @@ RunningState::RunningState(const Config& cfg, const std::filesystem::path& out_d
   sim.dynamics().force_balance().set_check_residual(true);
 }
 
-bool RunningState::finished(const Config& cfg) const {
-  const Dynamics& d = sim.dynamics();
+template <class D>
+bool RunningStateOf<D>::finished(const Config& cfg) const {
+  const auto& d = sim.dynamics();
   for (const auto& o : observers)
     if (o->done(d)) return true;
   return d.strain() >= cfg.run.strain * (1.0 - 1e-12) ||
          (cfg.run.max_steps > 0 && d.steps() >= cfg.run.max_steps);
 }
 
-double RunningState::planned_end_strain(const Config& cfg) const {
+template <class D>
+double RunningStateOf<D>::planned_end_strain(const Config& cfg) const {
   // A pressure cell that has found its steady state stops at steady + measure_strain.
   double end = cfg.run.strain;
   for (const auto& o : observers) end = std::min(end, o->planned_end_strain());
@@ -76,12 +79,14 @@ double RunningState::planned_end_strain(const Config& cfg) const {
 
 // ---- TrajectoryOutput ----------------------------------------------------------------------
 
-TrajectoryOutput::TrajectoryOutput(const Config& cfg, const RunningState& run,
-                                   const RunDirectory& dir, const std::string& resolved,
-                                   bool resume) {
-  if (!cfg.output.trajectory) return;
-  const Dynamics& d = run.sim.dynamics();
-  const Particles& p = d.particles();
+namespace {
+
+// The trajectory of discs, opened (resume: cut back to the checkpoint's frames).
+std::unique_ptr<H5mdWriter> open_disc_trajectory(const Config& cfg, const RunningStateOf<Dim2>& run,
+                                                 const RunDirectory& dir,
+                                                 const std::string& resolved, bool resume) {
+  const auto& d = run.sim.dynamics();
+  const auto& p = d.particles();
   TrajectoryLayout layout;
   for (const auto& o : run.observers) {
     for (auto& n : o->frame_names()) layout.observables.push_back(n);
@@ -100,14 +105,13 @@ TrajectoryOutput::TrajectoryOutput(const Config& cfg, const RunningState& run,
   layout.creator_version = SHEARDIFF_VERSION;
   layout.config_toml = resolved;
   const auto file = dir.file("trajectory.h5");
-  writer_ = resume ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, run.frames))
-                   : std::make_unique<H5mdWriter>(file, layout);
+  return resume ? std::make_unique<H5mdWriter>(H5mdWriter::resume(file, layout, run.frames))
+                : std::make_unique<H5mdWriter>(file, layout);
 }
 
-void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
-                                   const std::vector<double>& values) {
-  if (!writer_) return;
-  const Dynamics& d = run.sim.dynamics();
+void write_disc_frame(H5mdWriter& writer, const Config& cfg, const RunningStateOf<Dim2>& run,
+                      const std::vector<double>& values) {
+  const auto& d = run.sim.dynamics();
   FrameData f;
   f.step = d.steps();
   f.time = d.time();
@@ -123,10 +127,35 @@ void TrajectoryOutput::write_frame(const Config& cfg, const RunningState& run,
   ContactNetwork contacts;
   if (cfg.output.contacts) contacts = contact_network(d);
   f.contacts = &contacts;
-  writer_->write_frame(f);
+  writer.write_frame(f);
 }
 
-void TrajectoryOutput::flush_now_and_then() {
+}  // namespace
+
+template <class D>
+TrajectoryOutputOf<D>::TrajectoryOutputOf(const Config& cfg,
+                                          [[maybe_unused]] const RunningStateOf<D>& run,
+                                          [[maybe_unused]] const RunDirectory& dir,
+                                          [[maybe_unused]] const std::string& resolved,
+                                          [[maybe_unused]] bool resume) {
+  if (!cfg.output.trajectory) return;
+  if constexpr (D::space == 2)
+    writer_ = open_disc_trajectory(cfg, run, dir, resolved, resume);
+  else
+    throw ConfigError(
+        "output.trajectory: a scene of spheres has no trajectory writer yet; set it to false");
+}
+
+template <class D>
+void TrajectoryOutputOf<D>::write_frame([[maybe_unused]] const Config& cfg,
+                                        [[maybe_unused]] const RunningStateOf<D>& run,
+                                        [[maybe_unused]] const std::vector<double>& values) {
+  if constexpr (D::space == 2)
+    if (writer_) write_disc_frame(*writer_, cfg, run, values);
+}
+
+template <class D>
+void TrajectoryOutputOf<D>::flush_now_and_then() {
   if (!writer_) return;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_flush_ > std::chrono::seconds(2)) {
@@ -135,7 +164,8 @@ void TrajectoryOutput::flush_now_and_then() {
   }
 }
 
-void TrajectoryOutput::close() {
+template <class D>
+void TrajectoryOutputOf<D>::close() {
   flush();
   writer_.reset();
 }
@@ -145,7 +175,8 @@ void TrajectoryOutput::close() {
 // The whole evolving state of the run, in one fixed order for saving and loading.
 // with_counters: version 3 checkpoints also hold the solver's work counters, and after them
 // the run's start time (absent from those of a sheardiff before it: then unknown).
-void CheckpointStore::serialize(Archive& a, RunningState& run, int layout) const {
+template <class D>
+void CheckpointStoreOf<D>::serialize(Archive& a, RunningStateOf<D>& run, int layout) const {
   const bool with_counters = layout >= 3;
   std::string config = resolved_;
   a.io(config);
@@ -155,7 +186,7 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, int layout) const
         "--resume {}: the configuration differs from the one the checkpoint was written with "
         "(see {}/config.toml)",
         out_, out_));
-  Dynamics& d = run.dynamics();
+  auto& d = run.dynamics();
   d.serialize(a, layout >= 5);
   run.sim.serialize_integrator(a);
   for (auto& o : run.observers) o->serialize(a);
@@ -171,12 +202,13 @@ void CheckpointStore::serialize(Archive& a, RunningState& run, int layout) const
   }
 }
 
-void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
+template <class D>
+void CheckpointStoreOf<D>::load(RunningStateOf<D>& run, CheckpointPayload payload) const {
   // Layout 4 moved the gap profiles out of the pressure cell's section (ProfilesObserver): an
   // older pressure-cell state cannot be placed, and reading it would fail half-way as "corrupt".
   if (payload.layout < 4)
     for (const auto& o : run.observers)
-      if (dynamic_cast<const PressureCellObserver*>(o.get()) != nullptr)
+      if (dynamic_cast<const PressureCellObserverOf<D>*>(o.get()) != nullptr)
         throw CorruptCheckpoint(fmt::format(
             "{} was written by an earlier sheardiff (checkpoint layout {}), whose pressure-cell "
             "state this version stores differently. It was neither resumed nor changed: finish "
@@ -186,7 +218,7 @@ void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
   // Layout 6 accumulates the diffusion analysis instead of keeping the window's frames.
   if (payload.layout < 6)
     for (const auto& o : run.observers)
-      if (dynamic_cast<const DiffusionObserver*>(o.get()) != nullptr)
+      if (dynamic_cast<const DiffusionObserverOf<D>*>(o.get()) != nullptr)
         throw CorruptCheckpoint(fmt::format(
             "{} was written by an earlier sheardiff (checkpoint layout {}), which kept the "
             "measured window's frames for the diffusion analysis; this version accumulates it "
@@ -205,8 +237,10 @@ void CheckpointStore::load(RunningState& run, CheckpointPayload payload) const {
   if (!a.at_end()) unreadable_checkpoint(file_, "bytes are left after the state");
 }
 
-void CheckpointStore::save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory,
-                           const std::filesystem::path& to) const {
+template <class D>
+void CheckpointStoreOf<D>::save(RunningStateOf<D>& run, double elapsed_now,
+                                TrajectoryOutputOf<D>& trajectory,
+                                const std::filesystem::path& to) const {
   trajectory.flush();  // the trajectory holds every frame the checkpoint counts
   Archive a = Archive::writer();
   double total = run.elapsed_before + elapsed_now;
@@ -220,7 +254,8 @@ void CheckpointStore::save(RunningState& run, double elapsed_now, TrajectoryOutp
 
 // ---- RunProgress ---------------------------------------------------------------------------
 
-RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds, const Dynamics& d)
+RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds, double strain,
+                         long steps)
     : dir_(dir),
       progress_(progress),
       tty_(progress && dir.terminal()),
@@ -228,27 +263,23 @@ RunProgress::RunProgress(RunDirectory& dir, bool progress, double seconds, const
       t0_(std::chrono::steady_clock::now()),
       last_print_(t0_),
       last_line_(t0_),
-      strain0_(d.strain()),
-      steps0_(d.steps()) {}
+      strain0_(strain),
+      steps0_(steps) {}
 
 double RunProgress::elapsed() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
 }
 
-void RunProgress::update(const Config& cfg, const RunningState& run) {
+void RunProgress::update(double strain, long steps, double end, const std::string& more) {
   const auto now = std::chrono::steady_clock::now();
   const bool live = tty_ && now - last_print_ > std::chrono::milliseconds(500);
   const bool line = std::chrono::duration<double>(now - last_line_).count() > seconds_;
   if (!live && !line) return;
-  const Dynamics& d = run.sim.dynamics();
   const double el = std::chrono::duration<double>(now - t0_).count();
-  const double end = run.planned_end_strain(cfg);
-  const double eta = el * std::max(end - d.strain(), 0.0) / std::max(d.strain() - strain0_, 1e-12);
+  const double eta = el * std::max(end - strain, 0.0) / std::max(strain - strain0_, 1e-12);
   std::string text =
-      fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}", d.strain(), end,
-                  d.steps(), static_cast<double>(d.steps() - steps0_) / el, duration_text(eta));
-  for (const auto& o : run.observers)
-    if (const std::string more = o->progress(); !more.empty()) text += "  " + more;
+      fmt::format("strain {:.4g} / {:.4g}  steps {}  {:.0f} steps/s  ETA {}{}", strain, end, steps,
+                  static_cast<double>(steps - steps0_) / el, duration_text(eta), more);
   if (live) {
     std::fprintf(stderr, "\r%s   ", text.c_str());
     last_print_ = now;
@@ -271,10 +302,11 @@ void RunProgress::end_line() {
 
 // ---- The summary ---------------------------------------------------------------------------
 
-nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
-                           RunDirectory& dir, TrajectoryOutput& trajectory) {
-  const Dynamics& d = run.sim.dynamics();
-  const Particles& p = d.particles();
+template <class D>
+nlohmann::json run_summary(const Config& cfg, RunningStateOf<D>& run, double wall_seconds,
+                           RunDirectory& dir, TrajectoryOutputOf<D>& trajectory) {
+  const auto& d = run.sim.dynamics();
+  const auto& p = d.particles();
   nlohmann::json js;
   js[summary_key::version] = version();
   js[summary_key::git_hash] = git_hash();
@@ -287,6 +319,7 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
     js[summary_key::started] = nullptr;
   js[summary_key::finished] = iso8601_utc_now();
   js[summary_key::scene] = cfg.scene.type;
+  js[summary_key::dimension] = D::space;
   js[summary_key::N] = static_cast<std::int64_t>(p.n_mobile);
   if (scene_kind(cfg.scene.type).imposes_shear_rate()) js[summary_key::J] = cfg.flow.j;
   js[summary_key::ktilde] = cfg.contact.ktilde;
@@ -326,9 +359,9 @@ nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_sec
   });
   run.health.report(js);
   if (!js.contains(summary_key::phi)) {
-    double area = 0;
-    for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
-    js[summary_key::phi] = area / (d.box().lx * d.height());
+    double taken = 0;
+    for (std::size_t i = 0; i < p.n_mobile; ++i) taken += particle_measure<D>(p.radius[i]);
+    js[summary_key::phi] = taken / (band_section(d) * d.height());
   }
   return js;
 }
@@ -338,31 +371,49 @@ ObserverList make_observers(const Config& cfg, const std::filesystem::path& out_
   return make_observers(scene_kind(cfg.scene.type), cfg, out_dir);
 }
 
-ObserverList make_observers(const SceneKind& scene, const Config& cfg,
-                            const std::filesystem::path& out_dir) {
-  ObserverList obs;
-  obs.push_back(std::make_unique<RheologyObserver>(cfg.run.transient_strain));
+template <class D>
+ObserverListOf<D> make_observers_of(const SceneKind& scene, const Config& cfg,
+                                    const std::filesystem::path& out_dir) {
+  ObserverListOf<D> obs;
+  obs.push_back(std::make_unique<RheologyObserverOf<D>>(cfg.run.transient_strain));
   switch (scene.measures) {
     case Measures::ShearAfterTransient: {
       const double from = cfg.run.transient_strain;
-      add_shear_analyses(
-          obs, cfg, out_dir, [from](const Dynamics& d) { return d.strain() > from; },
+      add_shear_analyses<D>(
+          obs, cfg, out_dir, [from](const DynamicsOf<D>& d) { return d.strain() > from; },
           !scene.periodic_y);
       break;
     }
     case Measures::ShearFromSteadyState: {
-      auto cell = std::make_unique<PressureCellObserver>(cfg);
-      const PressureCellObserver* c = cell.get();
+      auto cell = std::make_unique<PressureCellObserverOf<D>>(cfg);
+      const PressureCellObserverOf<D>* c = cell.get();
       obs.push_back(std::move(cell));
-      add_shear_analyses(
-          obs, cfg, out_dir, [c](const Dynamics&) { return c->steady(); }, !scene.periodic_y);
+      add_shear_analyses<D>(
+          obs, cfg, out_dir, [c](const DynamicsOf<D>&) { return c->steady(); }, !scene.periodic_y);
       break;
     }
     case Measures::ChannelMigration:
-      obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
+      // The channel is a scene of discs (the configuration check refuses it with spheres).
+      if constexpr (D::space == 2)
+        obs.push_back(std::make_unique<ChannelObserver>(cfg, out_dir / kChannelFile));
       break;
   }
   return obs;
 }
+
+template struct RunningStateOf<Dim2>;
+template struct RunningStateOf<Dim3>;
+template class TrajectoryOutputOf<Dim2>;
+template class TrajectoryOutputOf<Dim3>;
+template class CheckpointStoreOf<Dim2>;
+template class CheckpointStoreOf<Dim3>;
+template nlohmann::json run_summary(const Config&, RunningStateOf<Dim2>&, double, RunDirectory&,
+                                    TrajectoryOutputOf<Dim2>&);
+template nlohmann::json run_summary(const Config&, RunningStateOf<Dim3>&, double, RunDirectory&,
+                                    TrajectoryOutputOf<Dim3>&);
+template ObserverListOf<Dim2> make_observers_of(const SceneKind&, const Config&,
+                                                const std::filesystem::path&);
+template ObserverListOf<Dim3> make_observers_of(const SceneKind&, const Config&,
+                                                const std::filesystem::path&);
 
 }  // namespace sheardiff

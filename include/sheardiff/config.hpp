@@ -26,6 +26,7 @@ std::string default_scene_name();
 struct Config {
   struct Scene {
     std::string type = default_scene_name();
+    std::int64_t dimension = 2;  // 2: discs in a monolayer; 3: spheres
   } scene;
   struct ParticlesCfg {
     std::int64_t n = 500;

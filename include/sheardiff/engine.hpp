@@ -3,6 +3,7 @@
 // state read. Nothing here writes a file: a run to a directory is run.hpp.
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/integrator/integrators.hpp"
@@ -11,12 +12,24 @@
 
 namespace sheardiff {
 
-// A run as a value: the scene, the engine composed for it and the integrator. Tests build one
-// from a Config (or a hand-made Scene) and step it.
-class Simulation {
+// The scene of a dimension: discs (Scene) or spheres (Scene3).
+template <class D>
+using SceneOf = std::conditional_t<D::space == 2, Scene, Scene3>;
+
+// The scene cfg asks for in dimension D (scene.dimension), built.
+template <class D>
+SceneOf<D> build_scene_of(const Config& cfg);
+
+// A run as a value: the scene, the engine composed for it and the integrator, in the dimension
+// D. Tests build one from a Config (or a hand-made scene) and step it.
+template <class D>
+class SimulationOf {
  public:
-  explicit Simulation(const Config& cfg);
-  Simulation(const Config& cfg, Scene scene);
+  using Dynamics = DynamicsOf<D>;
+  using Integrator = IntegratorOf<D>;
+
+  explicit SimulationOf(const Config& cfg);
+  SimulationOf(const Config& cfg, SceneOf<D> scene);
 
   // One integrator step; throws std::runtime_error if the linear solve fails.
   void step();
@@ -41,6 +54,9 @@ class Simulation {
   std::unique_ptr<Integrator> integrator_;
   std::unique_ptr<Dynamics> dynamics_;
 };
+
+using Simulation = SimulationOf<Dim2>;
+using Simulation3 = SimulationOf<Dim3>;
 
 // Pair interaction range over the sum of the radii: lubrication reaches gaps up to h_max.
 double interaction_range_factor(const Config& cfg);

@@ -21,33 +21,37 @@
 namespace sheardiff {
 
 // Everything of a run that evolves: the simulation, its health checks and observers, and the
-// bookkeeping of its outputs.
-struct RunningState {
-  RunningState(const Config& cfg, const std::filesystem::path& out_dir, std::int64_t started_at);
+// bookkeeping of its outputs; in the run's dimension D (scene.dimension).
+template <class D>
+struct RunningStateOf {
+  RunningStateOf(const Config& cfg, const std::filesystem::path& out_dir, std::int64_t started_at);
 
-  Simulation sim;
-  RunHealth health;
-  std::vector<std::unique_ptr<Observer>> observers;
+  SimulationOf<D> sim;
+  RunHealthOf<D> health;
+  ObserverListOf<D> observers;
   double next_frame, next_checkpoint;
   double elapsed_before = 0.0;  // seconds run before this process (a resumed run)
   long frames = 0;
   // When the run started (a resumed run: its first start), as Unix seconds; -1: unknown.
   std::int64_t started;
 
-  Dynamics& dynamics() { return sim.dynamics(); }
+  DynamicsOf<D>& dynamics() { return sim.dynamics(); }
   // Whether an observer, run.strain or run.max_steps ends the run now.
   bool finished(const Config& cfg) const;
   // The strain the run will end at, as far as it is known now (the progress line's end).
   double planned_end_strain(const Config& cfg) const;
 };
 
-// The trajectory (H5MD) of a run, or nothing with output.trajectory = false.
-class TrajectoryOutput {
+// The trajectory (H5MD) of a run, or nothing with output.trajectory = false (a run of spheres
+// has none yet: the configuration check refuses one).
+template <class D>
+class TrajectoryOutputOf {
  public:
   // resume: append to the file cut back to the checkpoint's frames.
-  TrajectoryOutput(const Config& cfg, const RunningState& run, const RunDirectory& dir,
-                   const std::string& resolved, bool resume);
-  void write_frame(const Config& cfg, const RunningState& run, const std::vector<double>& values);
+  TrajectoryOutputOf(const Config& cfg, const RunningStateOf<D>& run, const RunDirectory& dir,
+                     const std::string& resolved, bool resume);
+  void write_frame(const Config& cfg, const RunningStateOf<D>& run,
+                   const std::vector<double>& values);
   void flush() {
     if (writer_) writer_->flush();
   }
@@ -64,21 +68,22 @@ class TrajectoryOutput {
 
 // checkpoint.bin: the whole RunningState in one fixed order, written atomically, read back
 // bit-identically; refused if it was written for another configuration.
-class CheckpointStore {
+template <class D>
+class CheckpointStoreOf {
  public:
-  CheckpointStore(std::filesystem::path file, std::string resolved_config, std::string out_dir)
+  CheckpointStoreOf(std::filesystem::path file, std::string resolved_config, std::string out_dir)
       : file_(std::move(file)), resolved_(std::move(resolved_config)), out_(std::move(out_dir)) {}
   // Throws ConfigError (another configuration, but one that only moves the run's end) or
   // CorruptCheckpoint.
-  void load(RunningState& run, CheckpointPayload payload) const;
+  void load(RunningStateOf<D>& run, CheckpointPayload payload) const;
   // elapsed_now: seconds this process has run; the trajectory is flushed first so that it holds
   // every frame the checkpoint counts. To file() unless another file is given (the final state).
-  void save(RunningState& run, double elapsed_now, TrajectoryOutput& trajectory,
+  void save(RunningStateOf<D>& run, double elapsed_now, TrajectoryOutputOf<D>& trajectory,
             const std::filesystem::path& to = {}) const;
   const std::filesystem::path& file() const { return file_; }
 
  private:
-  void serialize(Archive& a, RunningState& run, int layout) const;
+  void serialize(Archive& a, RunningStateOf<D>& run, int layout) const;
   std::filesystem::path file_;
   std::string resolved_, out_;
 };
@@ -87,12 +92,13 @@ class CheckpointStore {
 // every `seconds` off a terminal, or in run.log alone (a terminal, --quiet).
 class RunProgress {
  public:
-  // d: the state this process starts from (a resumed run's checkpoint), so that the rate and
-  // the ETA count only the steps taken since.
-  RunProgress(RunDirectory& dir, bool progress, double seconds, const Dynamics& d);
+  // strain, steps: where this process starts from (a resumed run's checkpoint), so that the
+  // rate and the ETA count only the steps taken since.
+  RunProgress(RunDirectory& dir, bool progress, double seconds, double strain, long steps);
   // Seconds since this process started the run.
   double elapsed() const;
-  void update(const Config& cfg, const RunningState& run);
+  // end: the strain the run will end at, as far as it is known now; more: the observers' words.
+  void update(double strain, long steps, double end, const std::string& more);
   // Ends a live line before anything else is printed.
   void end_line();
 
@@ -108,13 +114,24 @@ class RunProgress {
 
 // summary.json of a finished run: who ran what, the step statistics, and every observer's and
 // the health checks' results (observers may also write tables into the trajectory).
-nlohmann::json run_summary(const Config& cfg, RunningState& run, double wall_seconds,
-                           RunDirectory& dir, TrajectoryOutput& trajectory);
+template <class D>
+nlohmann::json run_summary(const Config& cfg, RunningStateOf<D>& run, double wall_seconds,
+                           RunDirectory& dir, TrajectoryOutputOf<D>& trajectory);
 
 // The observers the scene and the config ask for (and only those), in their update order: what
 // the scene measures (SceneKind::measures) decides which.
+template <class D>
+ObserverListOf<D> make_observers_of(const SceneKind& scene, const Config& cfg,
+                                    const std::filesystem::path& out_dir);
+inline ObserverList make_observers(const SceneKind& scene, const Config& cfg,
+                                   const std::filesystem::path& out_dir) {
+  return make_observers_of<Dim2>(scene, cfg, out_dir);
+}
 ObserverList make_observers(const Config& cfg, const std::filesystem::path& out_dir);
-ObserverList make_observers(const SceneKind& scene, const Config& cfg,
-                            const std::filesystem::path& out_dir);
+
+// The disc names (the 2D instantiation).
+using RunningState = RunningStateOf<Dim2>;
+using TrajectoryOutput = TrajectoryOutputOf<Dim2>;
+using CheckpointStore = CheckpointStoreOf<Dim2>;
 
 }  // namespace sheardiff

@@ -251,7 +251,7 @@ void DiffusionAccumulator::bulk_only(DiffusionReport& r, long block_samples, lon
                         ? m.count(0) / (parts * static_cast<double>(r.samples))
                         : 0.0;
   if (r.bulk_fraction <= 0.0) {
-    r.warnings.push_back("no disc is ever in the bulk: no bulk-only analysis");
+    r.warnings.push_back("no particle is ever in the bulk: no bulk-only analysis");
     return;
   }
   r.has_bulk = true;

@@ -60,8 +60,7 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
         break;
     }
   }
-  if constexpr (D::space == 3) lz = d.box().lz;
-  const double area = d.box().lx * d.height() * lz;
+  const double area = horizontal_area(d, lz) * d.height();
   s.sxx /= area;
   s.syy /= area;
   s.sxy /= area;
@@ -76,26 +75,31 @@ template StressSample measure_stress(const Dynamics&, const std::vector<PairTerm
 template StressSample measure_stress(const Dynamics3&, const std::vector<PairTermOf<Dim3>>&,
                                      const VelocitiesOf<Dim3>&, double);
 
-double normal_load_between(const Dynamics& d, const Velocities& v, double y1, double y2,
+template <class D>
+double normal_load_between(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y1, double y2,
                            double lz) {
   if (!(y2 > y1)) return 0.0;
   const auto& pairs = d.neighbours().pairs();
   const auto& terms = d.force_balance().terms();
-  const Particles& p = d.particles();
+  const auto& p = d.particles();
   double load = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const PairTerm& t = terms[k];
+    const auto& t = terms[k];
     if (!t.on) continue;
-    const Pair& pr = pairs[k];
+    const auto& pr = pairs[k];
     const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y();
     if (mid < y1 || mid >= y2) continue;
     // Lever arm r (not the stress convention's s for open pairs): sum of dy_ij f_y over the
     // band's pairs is exactly the band's mean of the force across a horizontal line.
-    const Vec2 fj = t.force(v.u[pr.i], v.u[pr.j]).segment<2>(3);
-    load += t.g.r * t.g.n.y() * fj.y();
+    const double fjy = t.force(v.u[pr.i], v.u[pr.j])(D::body + 1);
+    load += t.g.r * t.g.n.y() * fjy;
   }
-  return load / (d.box().lx * (y2 - y1) * lz);
+  return load / (horizontal_area(d, lz) * (y2 - y1));
 }
+
+template double normal_load_between(const Dynamics&, const Velocities&, double, double, double);
+template double normal_load_between(const Dynamics3&, const VelocitiesOf<Dim3>&, double, double,
+                                    double);
 
 ContactNetwork contact_network(const Dynamics& d) {
   ContactNetwork c;

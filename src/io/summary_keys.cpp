@@ -26,7 +26,10 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "version did not record it"},
            {sk::finished, "ISO 8601 UTC", "when the summary was written"},
            {sk::scene, "-", "`scene.type`: \"simple_shear\", \"pressure_shear\" or \"channel\""},
-           {sk::N, "count", "number of mobile discs (wall discs excluded)"},
+           {sk::dimension, "-",
+            "`scene.dimension`: 2 (discs in a monolayer) or 3 (spheres); phi is then an area or "
+            "a volume fraction"},
+           {sk::N, "count", "number of mobile particles (wall particles excluded)"},
            {sk::J, "1",
             "viscous number `flow.J` = eta gammadot / P, which is the shear rate in these units "
             "(not written for the channel)"},

@@ -31,8 +31,9 @@ DiffusionSettings diffusion_settings(const Config& cfg) {
   return s;
 }
 
-DiffusionObserver::DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
-                                     std::function<bool(const Dynamics&)> measuring)
+template <class D>
+DiffusionObserverOf<D>::DiffusionObserverOf(const Config& cfg, std::filesystem::path analysis_file,
+                                            MeasuredWindowOf<D> measuring)
     : settings_(diffusion_settings(cfg)),
       sample_strain_(cfg.analysis.sample_strain),
       next_sample_(cfg.analysis.sample_strain),
@@ -40,10 +41,11 @@ DiffusionObserver::DiffusionObserver(const Config& cfg, std::filesystem::path an
       measuring_(std::move(measuring)),
       exclusion_(cfg.observables.wall_exclusion) {}
 
-void DiffusionObserver::on_step(const StepView& v) {
+template <class D>
+void DiffusionObserverOf<D>::on_step(const StepView& v) {
   const Dynamics& d = v.dynamics;
   const bool measuring = measuring_(d);
-  const Particles& p = d.particles();
+  const auto& p = d.particles();
   // The x displacement relative to the imposed flow, integrated over every step of the window.
   if (measuring && particles_ > 0)
     for (std::size_t i = 0; i < p.n_mobile; ++i)
@@ -63,15 +65,17 @@ void DiffusionObserver::on_step(const StepView& v) {
   take_sample(v);
 }
 
-void DiffusionObserver::on_frame(const StepView& v, std::vector<double>&) {
+template <class D>
+void DiffusionObserverOf<D>::on_frame(const StepView& v, std::vector<double>&) {
   if (due_at_step_ != v.dynamics.steps() || !measuring_(v.dynamics)) return;
   due_at_step_ = -1;
   take_sample(v);
 }
 
-void DiffusionObserver::take_sample(const StepView& v) {
+template <class D>
+void DiffusionObserverOf<D>::take_sample(const StepView& v) {
   const Dynamics& d = v.dynamics;
-  const Particles& p = d.particles();
+  const auto& p = d.particles();
   if (particles_ == 0) {
     particles_ = static_cast<long>(p.n_mobile);
     walls_ = d.walls().has_value();
@@ -95,7 +99,8 @@ void DiffusionObserver::take_sample(const StepView& v) {
   acc_.add(y_.data(), vy_.data(), x_.data(), walls_ ? bulk_.data() : nullptr);
 }
 
-void DiffusionObserver::serialize(Archive& a) {
+template <class D>
+void DiffusionObserverOf<D>::serialize(Archive& a) {
   a.tag("diffusion_samples");
   a.io(next_sample_), a.io(particles_), a.io(walls_), a.io(skipped_), a.io(x_);
   if (a.loading() && particles_ > 0)
@@ -103,7 +108,8 @@ void DiffusionObserver::serialize(Archive& a) {
   if (particles_ > 0) acc_.serialize(a);
 }
 
-void DiffusionObserver::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*) {
+template <class D>
+void DiffusionObserverOf<D>::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*) {
   try {
     if (particles_ == 0) throw std::invalid_argument("no sample was taken in the measured window");
     DiffusionReport r = acc_.report();
@@ -120,6 +126,9 @@ void DiffusionObserver::finish(const Dynamics&, nlohmann::json& js, H5mdWriter*)
     js[summary_key::analysis_warnings] = {fmt::format("no diffusion analysis: {}", e.what())};
   }
 }
+
+template class DiffusionObserverOf<Dim2>;
+template class DiffusionObserverOf<Dim3>;
 
 namespace {
 

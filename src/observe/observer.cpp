@@ -6,21 +6,25 @@
 
 namespace sheardiff {
 
-std::vector<std::string> RheologyObserver::frame_names() const {
+template <class D>
+std::vector<std::string> RheologyObserverOf<D>::frame_names() const {
   return {"strain", "shear_stress", "pressure", "sigma_xx", "sigma_yy", "contacts", "max_overlap"};
 }
 
-std::vector<std::string> RheologyObserver::frame_units() const {
+template <class D>
+std::vector<std::string> RheologyObserverOf<D>::frame_units() const {
   return {"1", "P", "P", "P", "P", "1", "d"};
 }
 
-void RheologyObserver::on_frame(const StepView& v, std::vector<double>& values) {
+template <class D>
+void RheologyObserverOf<D>::on_frame(const StepView& v, std::vector<double>& values) {
   const StressSample& s = v.stress;
   values.insert(values.end(), {v.dynamics.strain(), s.shear_stress(), s.pressure(), s.sxx, s.syy,
                                static_cast<double>(s.contacts), s.max_overlap});
 }
 
-void RheologyObserver::on_step(const StepView& v) {
+template <class D>
+void RheologyObserverOf<D>::on_step(const StepView& v) {
   const StressSample& s = v.stress;
   max_overlap_ = std::max(max_overlap_, s.max_overlap);
   if (v.dynamics.strain() <= transient_) return;
@@ -31,7 +35,8 @@ void RheologyObserver::on_step(const StepView& v) {
   mean_overlap_ += v.dt * s.mean_overlap;
 }
 
-void RheologyObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
+template <class D>
+void RheologyObserverOf<D>::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*) {
   js[summary_key::max_overlap] = max_overlap_;
   js[summary_key::averaged_from_strain] = transient_;
   if (weight_ <= 0.0) {
@@ -50,5 +55,8 @@ void RheologyObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter*
       contacts_ / w / static_cast<double>(d.particles().n_mobile);
   js[summary_key::viscosity] = d.flow().gammadot > 0 ? sxy_ / w / d.flow().gammadot : 0.0;
 }
+
+template class RheologyObserverOf<Dim2>;
+template class RheologyObserverOf<Dim3>;
 
 }  // namespace sheardiff

@@ -94,8 +94,9 @@ void add_stationarity(nlohmann::json& js, const StationarityVerdict& v) {
 namespace {
 
 // The bulk band: wall_exclusion inside each wall's centre line, or the whole gap of a thin cell.
-std::pair<double, double> bulk_band(const Dynamics& d, double exclusion) {
-  const Particles& p = d.particles();
+template <class D>
+std::pair<double, double> bulk_band(const DynamicsOf<D>& d, double exclusion) {
+  const auto& p = d.particles();
   const double yb = mean_height(p, d.walls()->bottom), yt = mean_height(p, d.walls()->top);
   double y1 = yb + exclusion, y2 = yt - exclusion;
   if (y2 - y1 < 1.0) y1 = yb, y2 = yt;
@@ -104,7 +105,8 @@ std::pair<double, double> bulk_band(const Dynamics& d, double exclusion) {
 
 }  // namespace
 
-PressureCellObserver::PressureCellObserver(const Config& cfg)
+template <class D>
+PressureCellObserverOf<D>::PressureCellObserverOf(const Config& cfg)
     : steady_cfg_(cfg.steady),
       exclusion_(cfg.observables.wall_exclusion),
       pressure_(1.0),
@@ -112,16 +114,18 @@ PressureCellObserver::PressureCellObserver(const Config& cfg)
       run_strain_(cfg.run.strain),
       error_block_(cfg.analysis.error_block) {}
 
-double PressureCellObserver::bulk_phi(const Dynamics& d, double exclusion) {
-  const Particles& p = d.particles();
+template <class D>
+double PressureCellObserverOf<D>::bulk_phi(const Dynamics& d, double exclusion) {
+  const auto& p = d.particles();
   const auto [y1, y2] = bulk_band(d, exclusion);
-  double area = 0.0;
+  double taken = 0.0;
   for (std::size_t i = 0; i < p.n_mobile; ++i)
-    area += disc_area_between(p.position[i].y(), p.radius[i], y1, y2);
-  return area / (d.box().lx * (y2 - y1));
+    taken += measure_between<D>(p.position[i].y(), p.radius[i], y1, y2);
+  return taken / (band_section(d) * (y2 - y1));
 }
 
-std::vector<std::string> PressureCellObserver::frame_names() const {
+template <class D>
+std::vector<std::string> PressureCellObserverOf<D>::frame_names() const {
   return {"H",
           "phi",
           "mu_top",
@@ -132,13 +136,15 @@ std::vector<std::string> PressureCellObserver::frame_names() const {
           "bulk_normal_load"};
 }
 
-std::vector<std::string> PressureCellObserver::frame_units() const {
+template <class D>
+std::vector<std::string> PressureCellObserverOf<D>::frame_units() const {
   return {"d", "1", "1", "1", "P", "P d eta-1", "P", "P"};
 }
 
-void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& values) {
+template <class D>
+void PressureCellObserverOf<D>::on_frame(const StepView& v, std::vector<double>& values) {
   const Dynamics& d = v.dynamics;
-  const double a = d.box().lx * lz_;
+  const double a = horizontal_area(d, lz_);
   const double mu_top = -v.stress.top_wall_fx / a / pressure_;
   const double h = d.height(), phi = bulk_phi(d, exclusion_);
   const double mu_bottom = v.stress.bottom_wall_fx / a / pressure_;
@@ -188,9 +194,10 @@ void PressureCellObserver::on_frame(const StepView& v, std::vector<double>& valu
   }
 }
 
-void PressureCellObserver::on_step(const StepView& v) {
+template <class D>
+void PressureCellObserverOf<D>::on_step(const StepView& v) {
   const Dynamics& d = v.dynamics;
-  const double a = d.box().lx * lz_;
+  const double a = horizontal_area(d, lz_);
   if (v.velocities.wall_free_fall)
     ++free_fall_steps_;
   else
@@ -207,17 +214,20 @@ void PressureCellObserver::on_step(const StepView& v) {
   p_meas_ += w * v.stress.top_wall_fy / a;
 }
 
-double PressureCellObserver::planned_end_strain() const {
+template <class D>
+double PressureCellObserverOf<D>::planned_end_strain() const {
   if (steady() && steady_cfg_.measure_strain > 0.0) return steady_at_ + steady_cfg_.measure_strain;
-  return Observer::planned_end_strain();
+  return ObserverOf<D>::planned_end_strain();
 }
 
-bool PressureCellObserver::done(const Dynamics& d) const {
+template <class D>
+bool PressureCellObserverOf<D>::done(const Dynamics& d) const {
   return steady() && steady_cfg_.measure_strain > 0.0 &&
          d.strain() >= steady_at_ + steady_cfg_.measure_strain;
 }
 
-void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
+template <class D>
+void PressureCellObserverOf<D>::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
   js[summary_key::steady] = steady();
   js[summary_key::steady_strain] =
       steady() ? nlohmann::json(steady_from_) : nlohmann::json(nullptr);
@@ -254,5 +264,8 @@ void PressureCellObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWri
                                      s_load_, steady_at_, last, error_block_));
   (void)writer;
 }
+
+template class PressureCellObserverOf<Dim2>;
+template class PressureCellObserverOf<Dim3>;
 
 }  // namespace sheardiff

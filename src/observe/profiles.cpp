@@ -17,14 +17,24 @@ double disc_area_between(double yc, double a, double y1, double y2) {
   return y2 > y1 ? below(y2) - below(y1) : 0.0;
 }
 
+double sphere_volume_between(double yc, double a, double y1, double y2) {
+  // Volume of the cap below height y: pi h^2 (3 a - h) / 3, h = y - (yc - a) in [0, 2a].
+  const auto below = [&](double y) {
+    const double h = std::clamp(y - (yc - a), 0.0, 2.0 * a);
+    return kPi * h * h * (3.0 * a - h) / 3.0;
+  };
+  return y2 > y1 ? below(y2) - below(y1) : 0.0;
+}
+
 void GapProfiles::grow(std::size_t bins) {
   if (w_.size() < bins)
     for (auto* vec : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_}) vec->resize(bins, 0.0);
 }
 
-void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb, double height,
-                      double lx, double weight) {
-  lx_ = lx;
+template <class D>
+void GapProfiles::add(const ParticlesOf<D>& p, const std::vector<typename D::Body>& u, double yb,
+                      double height, double section, double weight) {
+  section_ = section;
   grow(static_cast<std::size_t>(std::ceil((height + 2.0) / bin_)));
   for (double& x : w_) x += weight;
   const auto bins = static_cast<long>(w_.size());
@@ -33,10 +43,10 @@ void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb,
     const auto lo = static_cast<long>(std::floor((y - a) / bin_));
     const auto hi = static_cast<long>(std::floor((y + a) / bin_));
     for (long b = std::max(0L, lo); b <= hi && b < bins; ++b)
-      area_[b] += weight * disc_area_between(y, a, b * bin_, (b + 1) * bin_);
+      area_[b] += weight * measure_between<D>(y, a, b * bin_, (b + 1) * bin_);
     const long c = static_cast<long>(std::floor(y / bin_));
     if (c < 0 || c >= bins) continue;
-    const Vec3& v = u[i];
+    const auto& v = u[i];
     n_[c] += weight;
     ux_[c] += weight * v.x();
     ux2_[c] += weight * v.x() * v.x();
@@ -44,31 +54,40 @@ void GapProfiles::add(const Particles& p, const std::vector<Vec3>& u, double yb,
   }
 }
 
-void GapProfiles::add_stress(const Dynamics& d, const Velocities& v, double yb, double lz,
+template <class D>
+void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double yb, double lz,
                              double weight) {
   const auto bins = static_cast<long>(w_.size());
   if (bins == 0) return;
   sxy_.resize(w_.size(), 0.0);
   sp_.resize(w_.size(), 0.0);
-  const double volume = d.box().lx * bin_ * lz;
+  const double volume = horizontal_area(d, lz) * bin_;
   const auto& pairs = d.neighbours().pairs();
   const auto& terms = d.force_balance().terms();
-  const Particles& p = d.particles();
+  const auto& p = d.particles();
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const PairTerm& t = terms[k];
+    const auto& t = terms[k];
     if (!t.on) continue;
-    const Pair& pr = pairs[k];
+    const auto& pr = pairs[k];
     const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y() - yb;
     // A pair with a wall disc may have its midpoint just outside the bins: the nearest one.
     const long c = std::clamp(static_cast<long>(std::floor(mid / bin_)), 0L, bins - 1);
     // The same pair stress as measure_stress (observe/stress.cpp), binned.
-    const Vec2 fj = t.force(v.u[pr.i], v.u[pr.j]).segment<2>(3);
+    const auto fj = t.force(v.u[pr.i], v.u[pr.j]).template segment<D::space>(D::body).eval();
     const double l = pr.history.touching ? t.g.r : t.g.s;
     const double sxx = -l * t.g.n.x() * fj.x(), syy = -l * t.g.n.y() * fj.y();
     sxy_[c] += weight * -0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x()) / volume;
     sp_[c] += weight * -0.5 * (sxx + syy) / volume;
   }
 }
+
+template void GapProfiles::add(const Particles&, const std::vector<Vec3>&, double, double, double,
+                               double);
+template void GapProfiles::add(const Particles3&, const std::vector<Vec6>&, double, double, double,
+                               double);
+template void GapProfiles::add_stress(const Dynamics&, const Velocities&, double, double, double);
+template void GapProfiles::add_stress(const Dynamics3&, const VelocitiesOf<Dim3>&, double, double,
+                                      double);
 
 Eigen::MatrixXd GapProfiles::table() const {
   const auto nb = static_cast<Eigen::Index>(w_.size());
@@ -77,7 +96,7 @@ Eigen::MatrixXd GapProfiles::table() const {
     const double n = n_[b];
     const double ux = n > 0 ? ux_[b] / n : 0.0;
     t(b, 0) = (static_cast<double>(b) + 0.5) * bin_;
-    t(b, 1) = w_[b] > 0 ? area_[b] / (w_[b] * lx_ * bin_) : 0.0;
+    t(b, 1) = w_[b] > 0 ? area_[b] / (w_[b] * section_ * bin_) : 0.0;
     t(b, 2) = ux;
     t(b, 3) = n > 0 ? ux2_[b] / n - ux * ux + uy2_[b] / n : 0.0;
   }
@@ -114,7 +133,8 @@ void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
   }
 }
 
-void ProfilesObserver::on_step(const StepView& v) {
+template <class D>
+void ProfilesObserverOf<D>::on_step(const StepView& v) {
   const Dynamics& d = v.dynamics;
   if (!d.walls() || !measuring_(d)) return;
   const double w = v.dt;
@@ -122,16 +142,20 @@ void ProfilesObserver::on_step(const StepView& v) {
   const double yb = mean_height(d.particles(), d.walls()->bottom);
   w_ += w;
   h_ += w * d.height();
-  profiles_.add(d.particles(), v.velocities.u, yb, d.height(), d.box().lx, w);
+  profiles_.add(d.particles(), v.velocities.u, yb, d.height(), band_section(d), w);
   profiles_.add_stress(d, v.velocities, yb, lz_, w);
 }
 
-void ProfilesObserver::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
+template <class D>
+void ProfilesObserverOf<D>::finish(const Dynamics& d, nlohmann::json& js, H5mdWriter* writer) {
   // Into summary.json (written whole or not at all), not into the trajectory: an HDF5 file
   // killed while its metadata is being changed can be left unreadable, and the end of a run
   // must be resumable at every instant (tests/cli/final_phase_kill.sh).
   (void)writer;
   if (w_ > 0.0) profiles_.to_summary(js, d.flow().gammadot, h_ / w_, exclusion_);
 }
+
+template class ProfilesObserverOf<Dim2>;
+template class ProfilesObserverOf<Dim3>;
 
 }  // namespace sheardiff

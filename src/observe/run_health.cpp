@@ -33,23 +33,25 @@ std::string HealthReport::message() const {
                      strain, what, advice);
 }
 
-RunHealth::RunHealth(const Config& cfg, const Dynamics& d)
+template <class D>
+RunHealthOf<D>::RunHealthOf(const Config& cfg, const Dynamics& d)
     : max_overlap_(cfg.health.max_overlap),
       max_residual_(cfg.health.max_residual),
       explicit_springs_(cfg.integrator.type != IntegratorType::Implicit),
       fixed_dt_(cfg.integrator.dt > 0.0),
       h0_(d.height()) {
-  const Particles& p = d.particles();
-  for (std::size_t i = 0; i < p.n_mobile; ++i) mobile_area_ += kPi * p.radius[i] * p.radius[i];
+  const auto& p = d.particles();
+  for (std::size_t i = 0; i < p.n_mobile; ++i) mobile_measure_ += particle_measure<D>(p.radius[i]);
 }
 
-double RunHealth::max_overlap(const Dynamics& d, std::size_t* pair) {
-  const Particles& p = d.particles();
+template <class D>
+double RunHealthOf<D>::max_overlap(const Dynamics& d, std::size_t* pair) {
+  const auto& p = d.particles();
   const auto& pairs = d.neighbours().pairs();
   double worst = 0.0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const Pair& pr = pairs[k];
-    const Vec2 rij = pair_separation(p, d.box(), pr);
+    const auto& pr = pairs[k];
+    const auto rij = pair_separation(p, d.box(), pr);
     // Compared squared: a square root per pair only for the few pairs that overlap.
     const double s = p.radius[pr.i] + p.radius[pr.j];
     const double r2 = rij.squaredNorm();
@@ -63,8 +65,9 @@ double RunHealth::max_overlap(const Dynamics& d, std::size_t* pair) {
   return worst;
 }
 
-HealthReport RunHealth::make(HealthProblem problem, const Dynamics& d, std::vector<int> ids,
-                             std::string what) const {
+template <class D>
+HealthReport RunHealthOf<D>::make(HealthProblem problem, const Dynamics& d, std::vector<int> ids,
+                                  std::string what) const {
   HealthReport r;
   r.problem = problem;
   r.step = d.steps();
@@ -118,8 +121,10 @@ std::string id_list(const std::vector<int>& ids) {
 
 }  // namespace
 
-std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities& v, double dt) {
-  const Particles& p = d.particles();
+template <class D>
+std::optional<HealthReport> RunHealthOf<D>::check(const Dynamics& d, const Velocities& v,
+                                                  double dt) {
+  const auto& p = d.particles();
   std::vector<int> bad;
   for (std::size_t i = 0; i < p.size() && bad.size() < 10; ++i)
     if (!p.position[i].allFinite() || (i < v.u.size() && !v.u[i].allFinite()))
@@ -137,7 +142,7 @@ std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities
   const double ov = max_overlap(d, &k);
   max_overlap_seen_ = std::max(max_overlap_seen_, ov);
   if (ov > max_overlap_) {
-    const Pair& pr = d.neighbours().pairs()[k];
+    const auto& pr = d.neighbours().pairs()[k];
     return make(HealthProblem::Overlap, d, {pr.i, pr.j},
                 fmt::format("particles {} and {} overlap by {:.3g} d > health.max_overlap = {} d",
                             pr.i, pr.j, ov, max_overlap_));
@@ -153,18 +158,19 @@ std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities
 
   if (d.walls()) {
     const double h = d.height();
-    const double lx = d.box().lx;
+    const double section = band_section(d);
     // A packing fills at most ~0.9 of the gap between the wall centre rows: all of it means
-    // the discs overlap massively or went through a wall.
-    if (!(mobile_area_ < lx * h))
+    // the particles overlap massively or went through a wall.
+    if (!(mobile_measure_ < section * h))
       return make(HealthProblem::WallCollapse, d, d.walls()->top,
                   fmt::format("wall gap H = {:.4g} d (initially {:.4g} d) is smaller than the "
-                              "discs' area over Lx = {:.4g} d",
-                              h, h0_, mobile_area_ / lx));
+                              "particles' {} over {} = {:.4g} d",
+                              h, h0_, D::space == 3 ? "volume" : "area",
+                              D::space == 3 ? "Lx Lz" : "Lx", mobile_measure_ / section));
     // The step limits move the wall by ~1e-3 d per step; half a diameter in one step, or a
     // gap doubled with a gas-like packing (phi < 0.1), means it was thrown off.
     const double jump = v.wall_v * dt;
-    if (std::abs(jump) > 0.5 || (h > 2.0 * h0_ && mobile_area_ < 0.1 * lx * h))
+    if (std::abs(jump) > 0.5 || (h > 2.0 * h0_ && mobile_measure_ < 0.1 * section * h))
       return make(jump < 0.0 ? HealthProblem::WallCollapse : HealthProblem::WallEscape, d,
                   d.walls()->top,
                   fmt::format("the top wall moved {:+.3g} d in one step (more than 0.5 d); gap "
@@ -184,7 +190,8 @@ std::optional<HealthReport> RunHealth::check(const Dynamics& d, const Velocities
   return std::nullopt;
 }
 
-HealthReport RunHealth::solver_failure(const Dynamics& d, const Velocities& v) const {
+template <class D>
+HealthReport RunHealthOf<D>::solver_failure(const Dynamics& d, const Velocities& v) const {
   std::size_t k = 0;
   const double ov = max_overlap(d, &k);
   std::vector<int> ids;
@@ -200,15 +207,17 @@ HealthReport RunHealth::solver_failure(const Dynamics& d, const Velocities& v) c
   return r;
 }
 
-void RunHealth::report(nlohmann::json& js) const {
+template <class D>
+void RunHealthOf<D>::report(nlohmann::json& js) const {
   js[summary_key::health] = {{"max_overlap", max_overlap_seen_},
                              {"max_residual", max_residual_seen_},
                              {"max_overlap_limit", max_overlap_},
                              {"max_residual_limit", max_residual_}};
 }
 
-void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, const Velocities& v,
-                      const HealthReport& r) {
+template <class D>
+void write_diagnostic(const std::filesystem::path& file, const DynamicsOf<D>& d,
+                      const VelocitiesOf<D>& v, const HealthReport& r) {
   std::ostringstream out;
   out << "# sheardiff diagnostic frame: the state at which the run health check stopped the run\n"
       << "# problem: " << to_string(r.problem) << "\n# step: " << r.step
@@ -217,17 +226,28 @@ void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, cons
   for (int i : r.particles) out << ' ' << i;
   out << fmt::format("\n# box: lx = {:.17g}, ly = {:.17g}, height = {:.17g}\n", d.box().lx,
                      d.box().ly, d.height());
-  out << "# id x y diameter ux uy omega motion flagged\n";
-  const Particles& p = d.particles();
+  out << (D::space == 3 ? "# id x y z diameter ux uy uz omega_x omega_y omega_z motion flagged\n"
+                        : "# id x y diameter ux uy omega motion flagged\n");
+  const auto& p = d.particles();
+  using Body = typename D::Body;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const Vec3 u = i < v.u.size() ? v.u[i] : Vec3::Zero();
+    const Body u = i < v.u.size() ? v.u[i] : Body::Zero();
     const bool flagged =
         std::find(r.particles.begin(), r.particles.end(), static_cast<int>(i)) != r.particles.end();
-    out << fmt::format("{} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {} {}\n", i,
-                       p.position[i].x(), p.position[i].y(), 2.0 * p.radius[i], u.x(), u.y(), u.z(),
-                       static_cast<int>(p.motion[i]), flagged ? 1 : 0);
+    out << i;
+    for (int c = 0; c < D::space; ++c) out << fmt::format(" {:.17g}", p.position[i](c));
+    out << fmt::format(" {:.17g}", 2.0 * p.radius[i]);
+    for (int c = 0; c < D::body; ++c) out << fmt::format(" {:.17g}", u(c));
+    out << fmt::format(" {} {}\n", static_cast<int>(p.motion[i]), flagged ? 1 : 0);
   }
   write_file_atomically(file, out.str());
 }
+
+template class RunHealthOf<Dim2>;
+template class RunHealthOf<Dim3>;
+template void write_diagnostic(const std::filesystem::path&, const Dynamics&, const Velocities&,
+                               const HealthReport&);
+template void write_diagnostic(const std::filesystem::path&, const Dynamics3&,
+                               const VelocitiesOf<Dim3>&, const HealthReport&);
 
 }  // namespace sheardiff

@@ -6,14 +6,20 @@
 
 namespace sheardiff {
 
-void add_shear_analyses(ObserverList& observers, const Config& cfg,
-                        const std::filesystem::path& out_dir, MeasuredWindow measuring,
+template <class D>
+void add_shear_analyses(ObserverListOf<D>& observers, const Config& cfg,
+                        const std::filesystem::path& out_dir, MeasuredWindowOf<D> measuring,
                         bool between_walls) {
   if (cfg.observables.profiles && between_walls)
-    observers.push_back(std::make_unique<ProfilesObserver>(cfg, measuring));
+    observers.push_back(std::make_unique<ProfilesObserverOf<D>>(cfg, measuring));
   if (cfg.analysis.diffusion)
-    observers.push_back(
-        std::make_unique<DiffusionObserver>(cfg, out_dir / kAnalysisFile, std::move(measuring)));
+    observers.push_back(std::make_unique<DiffusionObserverOf<D>>(cfg, out_dir / kAnalysisFile,
+                                                                 std::move(measuring)));
 }
+
+template void add_shear_analyses(ObserverListOf<Dim2>&, const Config&, const std::filesystem::path&,
+                                 MeasuredWindowOf<Dim2>, bool);
+template void add_shear_analyses(ObserverListOf<Dim3>&, const Config&, const std::filesystem::path&,
+                                 MeasuredWindowOf<Dim3>, bool);
 
 }  // namespace sheardiff

@@ -31,7 +31,24 @@ void add_wall(Particles3& p, std::vector<int>& ids, double l, double base, int s
     }
 }
 
+// Lattice sites one largest diameter plus a margin apart, per_side x per_side in x-z.
+double site_spacing(const Config& cfg) {
+  return std::max(1.0, cfg.particles.size_ratio) + 0.1;
+}
+int sites_per_side(const Config& cfg) {
+  return std::max(2,
+                  static_cast<int>(std::lround(std::cbrt(static_cast<double>(cfg.particles.n)))));
+}
+
 }  // namespace
+
+PlannedCell pressure_shear_3d_cell(const Config& cfg) {
+  const int per_side = sites_per_side(cfg);
+  const double spacing = site_spacing(cfg), l = per_side * spacing;
+  const auto layers =
+      static_cast<double>((cfg.particles.n + per_side * per_side - 1) / (per_side * per_side));
+  return {.lx = l, .ly = (layers + 1.0) * spacing, .lz = l};
+}
 
 Scene3 build_pressure_shear_3d(const Config& cfg) {
   const std::int64_t n = cfg.particles.n;
@@ -39,12 +56,10 @@ Scene3 build_pressure_shear_3d(const Config& cfg) {
   std::vector<int> species = bidisperse_species(n, cfg.particles.mix, ratio);
   std::mt19937_64 rng(static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
   std::shuffle(species.begin(), species.end(), rng);
-  // Lattice sites one largest diameter plus a margin apart, per_side x per_side in x-z and as
-  // many layers in y as it takes; each centre jittered by up to 0.02 spacing per axis, so that
-  // no two spheres touch (1.5 - 0.06 > 1.4 at the default size ratio).
-  const double spacing = std::max(1.0, ratio) + 0.1;
-  const int per_side =
-      std::max(2, static_cast<int>(std::lround(std::cbrt(static_cast<double>(n)))));
+  // As many layers of sites in y as it takes; each centre jittered by up to 0.02 spacing per
+  // axis, so that no two spheres touch (1.5 - 0.06 > 1.4 at the default size ratio).
+  const double spacing = site_spacing(cfg);
+  const int per_side = sites_per_side(cfg);
   const auto layers = static_cast<int>((n + per_side * per_side - 1) / (per_side * per_side));
   const double l = per_side * spacing;
   std::uniform_real_distribution<double> jitter(-0.02, 0.02);

@@ -23,6 +23,7 @@ Scene build_channel(const Config& cfg);
 std::optional<ConfigProblem> check_channel(const Config& cfg);
 double channel_frame_spacing(const Config& cfg);
 PlannedCell channel_cell(const Config& cfg);
+PlannedCell pressure_shear_3d_cell(const Config& cfg);
 
 const std::vector<SceneKind>& scene_registry() {
   static const std::vector<SceneKind> rows = {
@@ -36,7 +37,10 @@ const std::vector<SceneKind>& scene_registry() {
               "the load P Lx lz (the packing dilates to phi(J))",
        .build = SHEARDIFF_SCENE(build_pressure_shear),
        .periodic_y = false,
-       .measures = Measures::ShearFromSteadyState},
+       .measures = Measures::ShearFromSteadyState,
+       .spheres = true,
+       .build_3d = SHEARDIFF_SCENE(build_pressure_shear_3d),
+       .planned_cell_3d = SHEARDIFF_SCENE(pressure_shear_3d_cell)},
       {.name = "channel",
        .doc = "`channel` = pressure-driven flow of monodisperse discs between two fixed rows of "
               "wall discs at a fixed mean velocity <u> (migration; the second seed paper)",
@@ -54,6 +58,13 @@ const SceneKind& scene_kind(const std::string& name) {
   for (const SceneKind& k : scene_registry())
     if (name == k.name) return k;
   throw ConfigError(fmt::format("scene.type: unknown scene \"{}\"", name));
+}
+
+std::string scenes_of_spheres() {
+  std::string names;
+  for (const SceneKind& k : scene_registry())
+    if (k.spheres) names += fmt::format("{}`{}`", names.empty() ? "" : ", ", k.name);
+  return names.empty() ? "no scene" : names;
 }
 
 std::string default_scene_name() {

@@ -32,7 +32,31 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
 // area (-sigma_yy with the lever arm r for every pair). Where nothing moves on average in y,
 // momentum balance makes it equal the load on the walls at every height; a packing that
 // dilates from its middle carries more than P there though its net drag is zero.
-double normal_load_between(const Dynamics& d, const Velocities& v, double y1, double y2, double lz);
+template <class D>
+double normal_load_between(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y1, double y2,
+                           double lz);
+
+// The area a force across a horizontal plane is spread over: lx lz, lz the monolayer's
+// thickness for discs and the periodic cell's depth for spheres.
+template <class D>
+double horizontal_area(const DynamicsOf<D>& d, double lz) {
+  if constexpr (D::space == 3) lz = d.box().lz;
+  return d.box().lx * lz;
+}
+// What a horizontal band's volume fraction is over, per unit height: lx for discs (an area
+// fraction), lx lz for spheres.
+template <class D>
+double band_section(const DynamicsOf<D>& d) {
+  if constexpr (D::space == 3) return d.box().lx * d.box().lz;
+  return d.box().lx;
+}
+// A particle's own measure: a disc's area, a sphere's volume.
+template <class D>
+double particle_measure(double a) {
+  if constexpr (D::space == 3) return 4.0 / 3.0 * kPi * a * a * a;
+  return kPi * a * a;
+}
+
 // Weighted mean of two samples (stresses, wall forces, overlaps); the contact count of `a`.
 StressSample average(const StressSample& a, const StressSample& b);
 

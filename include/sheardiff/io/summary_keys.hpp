@@ -22,6 +22,7 @@ inline constexpr const char* seed = "seed";
 inline constexpr const char* started = "started";
 inline constexpr const char* finished = "finished";
 inline constexpr const char* scene = "scene";
+inline constexpr const char* dimension = "dimension";
 inline constexpr const char* N = "N";
 inline constexpr const char* J = "J";
 inline constexpr const char* ktilde = "ktilde";

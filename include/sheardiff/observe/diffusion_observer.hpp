@@ -18,11 +18,15 @@ DiffusionSettings diffusion_settings(const Config& cfg);
 // run. Nothing grows with the window: the checkpoint carries the accumulator. With
 // analysis.sample_strain = output.frame_strain the samples are the trajectory's frames, and
 // `sheardiff analyse DIR` recomputes the same numbers from them.
-class DiffusionObserver final : public Observer {
+template <class D>
+class DiffusionObserverOf final : public ObserverOf<D> {
  public:
+  using typename ObserverOf<D>::Dynamics;
+  using typename ObserverOf<D>::StepView;
+
   // measuring(d): whether the run is in the measured window.
-  DiffusionObserver(const Config& cfg, std::filesystem::path analysis_file,
-                    std::function<bool(const Dynamics&)> measuring);
+  DiffusionObserverOf(const Config& cfg, std::filesystem::path analysis_file,
+                      MeasuredWindowOf<D> measuring);
   void on_step(const StepView& v) override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
   void finish(const Dynamics& d, nlohmann::json& summary, H5mdWriter* writer) override;
@@ -35,7 +39,7 @@ class DiffusionObserver final : public Observer {
   double sample_strain_;
   double next_sample_;
   std::filesystem::path file_;
-  std::function<bool(const Dynamics&)> measuring_;
+  MeasuredWindowOf<D> measuring_;
   double exclusion_;
   long particles_ = 0;     // 0 until the first sample
   bool walls_ = false;     // samples carry a bulk mask
@@ -46,6 +50,8 @@ class DiffusionObserver final : public Observer {
   std::vector<double> y_, vy_;
   std::vector<std::uint8_t> bulk_;
 };
+
+using DiffusionObserver = DiffusionObserverOf<Dim2>;
 
 // What `sheardiff analyse DIR` found: the run's summary with every recomputed key, and where it
 // went. Keys the run lacked (a run without the diffusion analysis, an older version's) are

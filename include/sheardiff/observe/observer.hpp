@@ -15,21 +15,27 @@ class H5mdWriter;
 
 // Whether the run is in its measured window now (after the transient, or from a detected
 // steady state): what observers that average only over it are given.
-using MeasuredWindow = std::function<bool(const Dynamics&)>;
+template <class D>
+using MeasuredWindowOf = std::function<bool(const DynamicsOf<D>&)>;
 
 // What an observer sees after a step.
-struct StepView {
-  const Dynamics& dynamics;
-  const Velocities& velocities;
+template <class D>
+struct StepViewOf {
+  const DynamicsOf<D>& dynamics;
+  const VelocitiesOf<D>& velocities;
   const StressSample& stress;
   double dt;
 };
 
 // Reads the state after steps; never changes it. A run composes only the observers its scene
-// and config ask for.
-class Observer {
+// and config ask for. Written for the run's dimension D (Dim2: discs, Dim3: spheres).
+template <class D>
+class ObserverOf {
  public:
-  virtual ~Observer() = default;
+  using Dynamics = DynamicsOf<D>;
+  using StepView = StepViewOf<D>;
+
+  virtual ~ObserverOf() = default;
   // Scalar observables written to every trajectory frame (names fixed for the run).
   virtual std::vector<std::string> frame_names() const { return {}; }
   // Their H5MD unit strings in the project's units (docs/trajectory.md), same order.
@@ -56,12 +62,17 @@ class Observer {
 };
 
 // A run's observers, in their update order.
-using ObserverList = std::vector<std::unique_ptr<Observer>>;
+template <class D>
+using ObserverListOf = std::vector<std::unique_ptr<ObserverOf<D>>>;
 
 // Stress and contact statistics of any scene, time-averaged after run.transient_strain.
-class RheologyObserver final : public Observer {
+template <class D>
+class RheologyObserverOf final : public ObserverOf<D> {
  public:
-  explicit RheologyObserver(double transient_strain) : transient_(transient_strain) {}
+  using typename ObserverOf<D>::Dynamics;
+  using typename ObserverOf<D>::StepView;
+
+  explicit RheologyObserverOf(double transient_strain) : transient_(transient_strain) {}
   std::vector<std::string> frame_names() const override;
   std::vector<std::string> frame_units() const override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
@@ -78,5 +89,12 @@ class RheologyObserver final : public Observer {
   double weight_ = 0, sxy_ = 0, pressure_ = 0, contacts_ = 0, mean_overlap_ = 0;
   double max_overlap_ = 0;
 };
+
+// The disc names (the 2D instantiation).
+using MeasuredWindow = MeasuredWindowOf<Dim2>;
+using StepView = StepViewOf<Dim2>;
+using Observer = ObserverOf<Dim2>;
+using ObserverList = ObserverListOf<Dim2>;
+using RheologyObserver = RheologyObserverOf<Dim2>;
 
 }  // namespace sheardiff

@@ -31,9 +31,13 @@ void add_stationarity(nlohmann::json& js, const StationarityVerdict& v);
 // Observables of the pressure-imposed plane shear cell (docs/model.md section 9): gap H, bulk phi,
 // mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
 // drift of H and mu (its profiles across the gap: ProfilesObserver, over the steady window).
-class PressureCellObserver final : public Observer {
+template <class D>
+class PressureCellObserverOf final : public ObserverOf<D> {
  public:
-  explicit PressureCellObserver(const Config& cfg);
+  using typename ObserverOf<D>::Dynamics;
+  using typename ObserverOf<D>::StepView;
+
+  explicit PressureCellObserverOf(const Config& cfg);
   std::vector<std::string> frame_names() const override;
   std::vector<std::string> frame_units() const override;
   void on_frame(const StepView& v, std::vector<double>& values) override;
@@ -55,7 +59,7 @@ class PressureCellObserver final : public Observer {
 
   bool steady() const { return steady_at_ >= 0.0; }
   double steady_strain() const { return steady_from_; }
-  // Bulk area fraction of the current configuration.
+  // Bulk area (discs) or volume (spheres) fraction of the current configuration.
   static double bulk_phi(const Dynamics& d, double exclusion);
 
  private:
@@ -73,5 +77,7 @@ class PressureCellObserver final : public Observer {
   // ... and of the stationarity signals (net y drag on the discs, the bulk's normal load).
   std::vector<double> s_drag_, s_load_;
 };
+
+using PressureCellObserver = PressureCellObserverOf<Dim2>;
 
 }  // namespace sheardiff

@@ -12,19 +12,29 @@ namespace sheardiff {
 
 // Area of the disc (centre height yc, radius a) lying between heights y1 < y2.
 double disc_area_between(double yc, double a, double y1, double y2);
+// Volume of the sphere (centre height yc, radius a) lying between heights y1 < y2.
+double sphere_volume_between(double yc, double a, double y1, double y2);
+// The part of a particle between two heights: a disc's area, a sphere's volume.
+template <class D>
+double measure_between(double yc, double a, double y1, double y2) {
+  if constexpr (D::space == 3) return sphere_volume_between(yc, a, y1, y2);
+  return disc_area_between(yc, a, y1, y2);
+}
 
 // The profiles' accumulators, with any weight (dt during a run, 1 per frame when recomputed
 // from a trajectory).
 class GapProfiles {
  public:
   explicit GapProfiles(double bin) : bin_(bin) {}
-  // phi, u_x and T from the mobile discs and their velocities u; y_bottom: the bottom wall's
-  // centre line, height: the gap.
-  void add(const Particles& p, const std::vector<Vec3>& u, double y_bottom, double height,
-           double lx, double weight);
+  // phi, u_x and T from the mobile particles and their velocities u; y_bottom: the bottom
+  // wall's centre line, height: the gap, section: the cell's extent normal to y (band_section).
+  template <class D>
+  void add(const ParticlesOf<D>& p, const std::vector<typename D::Body>& u, double y_bottom,
+           double height, double section, double weight);
   // The pair stresses of the step (sigma = -sum l n f / V): each pair's share in the bin of its
-  // midpoint; lz: the monolayer's thickness.
-  void add_stress(const Dynamics& d, const Velocities& v, double y_bottom, double lz,
+  // midpoint; lz: the monolayer's thickness (discs).
+  template <class D>
+  void add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y_bottom, double lz,
                   double weight);
   bool empty() const { return w_.empty(); }
   // Rows = bins; columns y (bin centre), phi, u_x, T.
@@ -35,20 +45,24 @@ class GapProfiles {
   // gammadot = V / H.
   void to_summary(nlohmann::json& js, double gammadot, double height, double exclusion) const;
   void serialize(Archive& a) {
-    a.io(lx_);
+    a.io(section_);
     for (auto* v : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_, &sxy_, &sp_}) a.io(*v);
   }
 
  private:
   void grow(std::size_t bins);
-  double bin_, lx_ = 1.0;
+  double bin_, section_ = 1.0;  // the cell's extent normal to y (lx, or lx lz for spheres)
   std::vector<double> w_, area_, n_, ux_, ux2_, uy2_, sxy_, sp_;
 };
 
 // The profiles as an observer of any scene with walls, over the measured window.
-class ProfilesObserver final : public Observer {
+template <class D>
+class ProfilesObserverOf final : public ObserverOf<D> {
  public:
-  ProfilesObserver(const Config& cfg, MeasuredWindow measuring)
+  using typename ObserverOf<D>::Dynamics;
+  using typename ObserverOf<D>::StepView;
+
+  ProfilesObserverOf(const Config& cfg, MeasuredWindowOf<D> measuring)
       : profiles_(cfg.observables.profile_bin),
         exclusion_(cfg.observables.wall_exclusion),
         lz_(cfg.flow.lz),
@@ -64,8 +78,10 @@ class ProfilesObserver final : public Observer {
  private:
   GapProfiles profiles_;
   double exclusion_, lz_;
-  MeasuredWindow measuring_;
+  MeasuredWindowOf<D> measuring_;
   double w_ = 0.0, h_ = 0.0;  // measured time and time integral of the gap
 };
+
+using ProfilesObserver = ProfilesObserverOf<Dim2>;
 
 }  // namespace sheardiff

@@ -39,10 +39,14 @@ struct RunUnhealthy : std::runtime_error {
   HealthReport report;
 };
 
-class RunHealth {
+template <class D>
+class RunHealthOf {
  public:
+  using Dynamics = DynamicsOf<D>;
+  using Velocities = VelocitiesOf<D>;
+
   // Records the reference state (initial gap of a wall scene); build it on the initial state.
-  RunHealth(const Config& cfg, const Dynamics& d);
+  RunHealthOf(const Config& cfg, const Dynamics& d);
 
   // After a completed step with velocities v: the first problem found, if any.
   std::optional<HealthReport> check(const Dynamics& d, const Velocities& v, double dt);
@@ -65,14 +69,17 @@ class RunHealth {
 
   double max_overlap_, max_residual_;
   bool explicit_springs_, fixed_dt_;
-  double h0_ = 0.0;           // initial wall gap (wall scenes)
-  double mobile_area_ = 0.0;  // area of the mobile discs
+  double h0_ = 0.0;              // initial wall gap (wall scenes)
+  double mobile_measure_ = 0.0;  // area of the mobile discs, volume of the mobile spheres
   double max_overlap_seen_ = 0.0, max_residual_seen_ = 0.0;
 };
 
+using RunHealth = RunHealthOf<Dim2>;
+
 // A text frame of every particle (id, position, diameter, velocity, motion, flagged) headed
 // by the report, for post-mortems of a stopped run.
-void write_diagnostic(const std::filesystem::path& file, const Dynamics& d, const Velocities& v,
-                      const HealthReport& r);
+template <class D>
+void write_diagnostic(const std::filesystem::path& file, const DynamicsOf<D>& d,
+                      const VelocitiesOf<D>& v, const HealthReport& r);
 
 }  // namespace sheardiff

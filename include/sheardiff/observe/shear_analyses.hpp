@@ -13,8 +13,9 @@ namespace sheardiff {
 // Over the measured window, as cfg asks for them: the profiles across the gap (a cell between
 // walls, observables.profiles) and the diffusion analysis (analysis.diffusion, written to
 // out_dir/analysis.h5).
-void add_shear_analyses(ObserverList& observers, const Config& cfg,
-                        const std::filesystem::path& out_dir, MeasuredWindow measuring,
+template <class D>
+void add_shear_analyses(ObserverListOf<D>& observers, const Config& cfg,
+                        const std::filesystem::path& out_dir, MeasuredWindowOf<D> measuring,
                         bool between_walls);
 
 }  // namespace sheardiff

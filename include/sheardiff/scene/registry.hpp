@@ -15,6 +15,7 @@
 namespace sheardiff {
 
 struct Scene;
+struct Scene3;
 
 // A problem a scene finds in a configuration: the key, and what is wrong with it and what is
 // allowed (the parser adds where the configuration came from).
@@ -27,6 +28,7 @@ struct ConfigProblem {
 // periodic edges against the neighbour cut-off with it).
 struct PlannedCell {
   double lx = 0.0, ly = 0.0;
+  double lz = 0.0;  // spheres (scene.dimension = 3); 0 for discs
 };
 
 // What a scene measures; the run composes the observers for it (run_parts.cpp, make_observers).
@@ -59,6 +61,10 @@ struct SceneKind {
   // The cell, when the scene fixes it from its own keys. Null: the cell particles.N discs make
   // at particles.phi_init and particles.aspect (or particles.init_file's).
   PlannedCell (*planned_cell)(const Config& cfg) = nullptr;
+  // The scene has a scene of spheres (scene.dimension = 3): its builder and its cell.
+  bool spheres = false;
+  Scene3 (*build_3d)(const Config& cfg) = nullptr;
+  PlannedCell (*planned_cell_3d)(const Config& cfg) = nullptr;
 
   // The measured window starts at a detected steady state, not after run.transient_strain.
   bool measured_from_steady_state() const { return measures == Measures::ShearFromSteadyState; }
@@ -71,5 +77,7 @@ struct SceneKind {
 const std::vector<SceneKind>& scene_registry();
 // The row of scene.type = name; throws ConfigError for an unknown name.
 const SceneKind& scene_kind(const std::string& name);
+// The scenes that have a scene of spheres, as text for an error ("`pressure_shear`").
+std::string scenes_of_spheres();
 
 }  // namespace sheardiff
