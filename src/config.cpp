@@ -481,8 +481,8 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
   }
 }
 
-// Spheres: a scene that has them, placed by its own builder, written without a trajectory
-// (its writer is of discs).
+// Spheres: a scene that has them, placed by its own builder, written without the contact
+// network.
 void check_spheres(const Config& c, const std::string& origin) {
   if (c.scene.dimension != 3) return;
   if (!scene_kind(c.scene.type).spheres)
@@ -492,10 +492,10 @@ void check_spheres(const Config& c, const std::string& origin) {
   if (!c.particles.init_file.empty())
     fail(origin, "particles.init_file",
          "a scene of spheres (scene.dimension = 3) places its own spheres; leave it empty");
-  if (c.output.trajectory)
-    fail(origin, "output.trajectory",
-         "a scene of spheres (scene.dimension = 3) has no trajectory writer yet; set "
-         "output.trajectory = false (the diffusion analysis streams without it)");
+  if (c.output.trajectory && c.output.contacts)
+    fail(origin, "output.contacts",
+         "the contact network of spheres is not written (its tangential forces are vectors); set "
+         "output.contacts = false");
 }
 
 void check_combinations(const Config& c, const std::string& origin) {

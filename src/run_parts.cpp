@@ -81,10 +81,11 @@ double RunningStateOf<D>::planned_end_strain(const Config& cfg) const {
 
 namespace {
 
-// The trajectory of discs, opened (resume: cut back to the checkpoint's frames).
-std::unique_ptr<H5mdWriter> open_disc_trajectory(const Config& cfg, const RunningStateOf<Dim2>& run,
-                                                 const RunDirectory& dir,
-                                                 const std::string& resolved, bool resume) {
+// The trajectory, opened (resume: cut back to the checkpoint's frames).
+template <class D>
+std::unique_ptr<H5mdWriter> open_trajectory(const Config& cfg, const RunningStateOf<D>& run,
+                                            const RunDirectory& dir, const std::string& resolved,
+                                            bool resume) {
   const auto& d = run.sim.dynamics();
   const auto& p = d.particles();
   TrajectoryLayout layout;
@@ -98,6 +99,7 @@ std::unique_ptr<H5mdWriter> open_disc_trajectory(const Config& cfg, const Runnin
   for (Motion m : p.motion) layout.motion.push_back(static_cast<int>(m));
   layout.lx = d.box().lx;
   layout.ly = d.height();
+  layout.dimension = D::space;
   layout.lees_edwards = d.box().lees_edwards;
   layout.write_velocity = cfg.output.velocities;
   layout.write_contacts = cfg.output.contacts;
@@ -109,49 +111,50 @@ std::unique_ptr<H5mdWriter> open_disc_trajectory(const Config& cfg, const Runnin
                 : std::make_unique<H5mdWriter>(file, layout);
 }
 
-void write_disc_frame(H5mdWriter& writer, const Config& cfg, const RunningStateOf<Dim2>& run,
-                      const std::vector<double>& values) {
+template <class D>
+void write_trajectory_frame(H5mdWriter& writer, const Config& cfg, const RunningStateOf<D>& run,
+                            const std::vector<double>& values) {
   const auto& d = run.sim.dynamics();
+  const auto& p = d.particles();
   FrameData f;
   f.step = d.steps();
   f.time = d.time();
   f.lx = d.box().lx;
   f.ly = d.height();
   f.tilt = d.box().le_offset;
-  f.position = &d.particles().position;
-  // Without Lees-Edwards the unwrapped position is position + image . edges: not stored twice.
-  if (d.box().lees_edwards) f.unwrapped = &d.particles().unwrapped;
-  if (d.particles().image.size() == d.particles().size()) f.image = &d.particles().image;
-  f.velocity = &run.sim.integrator().velocities().u;
   f.observables = values;
+  const bool images = p.image.size() == p.size();
   ContactNetwork contacts;
-  if (cfg.output.contacts) contacts = contact_network(d);
-  f.contacts = &contacts;
+  if constexpr (D::space == 3) {
+    f.lz = d.box().lz;
+    f.position3 = &p.position;
+    if (images) f.image3 = &p.image;
+    f.velocity6 = &run.sim.integrator().velocities().u;
+  } else {
+    f.position = &p.position;
+    // Without Lees-Edwards the unwrapped position is position + image . edges: not stored twice.
+    if (d.box().lees_edwards) f.unwrapped = &p.unwrapped;
+    if (images) f.image = &p.image;
+    f.velocity = &run.sim.integrator().velocities().u;
+    if (cfg.output.contacts) contacts = contact_network(d);
+    f.contacts = &contacts;
+  }
   writer.write_frame(f);
 }
 
 }  // namespace
 
 template <class D>
-TrajectoryOutputOf<D>::TrajectoryOutputOf(const Config& cfg,
-                                          [[maybe_unused]] const RunningStateOf<D>& run,
-                                          [[maybe_unused]] const RunDirectory& dir,
-                                          [[maybe_unused]] const std::string& resolved,
-                                          [[maybe_unused]] bool resume) {
-  if (!cfg.output.trajectory) return;
-  if constexpr (D::space == 2)
-    writer_ = open_disc_trajectory(cfg, run, dir, resolved, resume);
-  else
-    throw ConfigError(
-        "output.trajectory: a scene of spheres has no trajectory writer yet; set it to false");
+TrajectoryOutputOf<D>::TrajectoryOutputOf(const Config& cfg, const RunningStateOf<D>& run,
+                                          const RunDirectory& dir, const std::string& resolved,
+                                          bool resume) {
+  if (cfg.output.trajectory) writer_ = open_trajectory(cfg, run, dir, resolved, resume);
 }
 
 template <class D>
-void TrajectoryOutputOf<D>::write_frame([[maybe_unused]] const Config& cfg,
-                                        [[maybe_unused]] const RunningStateOf<D>& run,
-                                        [[maybe_unused]] const std::vector<double>& values) {
-  if constexpr (D::space == 2)
-    if (writer_) write_disc_frame(*writer_, cfg, run, values);
+void TrajectoryOutputOf<D>::write_frame(const Config& cfg, const RunningStateOf<D>& run,
+                                        const std::vector<double>& values) {
+  if (writer_) write_trajectory_frame(*writer_, cfg, run, values);
 }
 
 template <class D>

@@ -42,8 +42,7 @@ struct RunningStateOf {
   double planned_end_strain(const Config& cfg) const;
 };
 
-// The trajectory (H5MD) of a run, or nothing with output.trajectory = false (a run of spheres
-// has none yet: the configuration check refuses one).
+// The trajectory (H5MD) of a run, or nothing with output.trajectory = false.
 template <class D>
 class TrajectoryOutputOf {
  public:

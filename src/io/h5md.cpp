@@ -623,6 +623,7 @@ struct H5mdWriter::Impl {
   void create_contacts();
   void check_frame(const FrameData& frame, bool want_images, bool want_unwrapped) const;
   void append_images(const FrameData& frame, double tilt, double ly);
+  void append_sphere_images(const FrameData& frame);
   void append_velocity(const FrameData& frame);
   void append_contacts(const ContactNetwork& c);
 
@@ -630,7 +631,8 @@ struct H5mdWriter::Impl {
   // from them (Lees-Edwards: x differs by the shift gained since each crossing).
   void create_images(bool with_unwrapped) {
     const hsize_t n = layout.n_particles;
-    image = element(susp("image"), H5T_STD_I32LE, {n, 2}, 1, kNumber);
+    const auto dim = static_cast<hsize_t>(layout.dimension);
+    image = element(susp("image"), H5T_STD_I32LE, {n, dim}, 1, kNumber);
     if (with_unwrapped)
       unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, 2}, 1, kLength);
   }
@@ -642,6 +644,10 @@ namespace {
 void check_layout(const fs::path& path, const TrajectoryLayout& layout) {
   const std::size_t n = layout.n_particles;
   if (n == 0) fail(path, kSuspension, "layout has no particles");
+  if (layout.dimension != 2 && layout.dimension != 3)
+    fail(path, susp("box"), fmt::format("dimension {} is neither 2 nor 3", layout.dimension));
+  if (layout.dimension == 3 && layout.write_contacts)
+    fail(path, kContacts, "the contact network of spheres is not written (its forces are vectors)");
   if (layout.species.size() != n || layout.diameter.size() != n || layout.motion.size() != n) {
     fail(path, kSuspension,
          fmt::format("layout arrays sizes species={} diameter={} motion={} != n_particles={}",
@@ -735,28 +741,32 @@ void H5mdWriter::Impl::leave_swmr() {
 void H5mdWriter::Impl::create_suspension() {
   const hid_t f = file.get();
   const std::size_t n = layout.n_particles;
+  const auto dim = static_cast<hsize_t>(layout.dimension);
   Handle particles = create_group(f, "/particles", path);
   Handle suspension = create_group(f, kSuspension, path);
   {
     const std::string box_name = susp("box");
     Handle box = create_group(f, box_name, path);
-    write_int_attr(box.get(), box_name, "dimension", {2}, true, path);
-    write_string_attr(box.get(), box_name, "boundary",
-                      {"periodic", layout.lees_edwards ? "periodic" : "none"}, false, path,
-                      Str::Fixed);
+    write_int_attr(box.get(), box_name, "dimension", {layout.dimension}, true, path);
+    std::vector<std::string> boundary = {"periodic", layout.lees_edwards ? "periodic" : "none"};
+    if (dim == 3) boundary.push_back("periodic");
+    write_string_attr(box.get(), box_name, "boundary", boundary, false, path, Str::Fixed);
   }
   {
     Handle position_group = create_group(f, susp("position"), path);
     step = create_series(f, kStep, H5T_STD_I64LE, {}, kScalarChunk, path);
     time = create_series(f, kTimeName, H5T_IEEE_F64LE, {}, kScalarChunk, path);
     write_unit(time.ds.get(), kTimeName, kTime, path);
-    position = create_series(f, susp("position/value"), H5T_IEEE_F64LE, {n, 2}, 1, path);
+    position = create_series(f, susp("position/value"), H5T_IEEE_F64LE, {n, dim}, 1, path);
     write_unit(position.ds.get(), position.name, kLength, path);
   }
-  edges = element(susp("box/edges"), H5T_IEEE_F64LE, {2, 2}, kScalarChunk, kLength);
+  edges = element(susp("box/edges"), H5T_IEEE_F64LE, {dim, dim}, kScalarChunk, kLength);
   if (layout.write_velocity) {
-    velocity = element(susp("velocity"), H5T_IEEE_F64LE, {n, 2}, 1, kVelocity);
-    angular_velocity = element(susp("angular_velocity"), H5T_IEEE_F64LE, {n}, 1, kRate);
+    velocity = element(susp("velocity"), H5T_IEEE_F64LE, {n, dim}, 1, kVelocity);
+    // omega_z of a disc, the vector omega of a sphere
+    angular_velocity =
+        element(susp("angular_velocity"), H5T_IEEE_F64LE,
+                dim == 3 ? std::vector<hsize_t>{n, 3} : std::vector<hsize_t>{n}, 1, kRate);
   }
   {
     // HDF5 converts enumerations to numbers on reading, not numbers to enumerations.
@@ -861,20 +871,22 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   const hid_t f = m->file.get();
   const auto rows = static_cast<hsize_t>(keep_frames);
   const hsize_t n = layout.n_particles;
+  const auto dim = static_cast<hsize_t>(layout.dimension);
   const auto value = [&](const std::string& full, std::vector<hsize_t> inner, bool ragged = false) {
     return open_series(f, full, std::move(inner), rows, path, ragged);
   };
   // Hard links: cutting position's step and time cuts every element's.
   m->step = value(kStep, {});
   m->time = value(kTimeName, {});
-  m->position = value(susp("position/value"), {n, 2});
-  m->edges = value(susp("box/edges/value"), {2, 2});
+  m->position = value(susp("position/value"), {n, dim});
+  m->edges = value(susp("box/edges/value"), {dim, dim});
   if (layout.write_velocity) {
-    m->velocity = value(susp("velocity/value"), {n, 2});
-    m->angular_velocity = value(susp("angular_velocity/value"), {n});
+    m->velocity = value(susp("velocity/value"), {n, dim});
+    m->angular_velocity = value(susp("angular_velocity/value"),
+                                dim == 3 ? std::vector<hsize_t>{n, 3} : std::vector<hsize_t>{n});
   }
   if (H5Lexists(f, susp("image").c_str(), H5P_DEFAULT) > 0)
-    m->image = value(susp("image/value"), {n, 2});
+    m->image = value(susp("image/value"), {n, dim});
   if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0)
     m->unwrapped = value(susp("unwrapped_position/value"), {n, 2});
   for (const auto& name : layout.observables)
@@ -908,15 +920,22 @@ void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_images,
                        n));
     }
   };
-  if (frame.position == nullptr) fail(path, susp("position"), "frame without positions");
-  check_size(frame.position->size(), susp("position"));
+  const bool spheres = layout.dimension == 3;
+  if (spheres ? frame.position3 == nullptr : frame.position == nullptr)
+    fail(path, susp("position"), "frame without positions");
+  check_size(spheres ? frame.position3->size() : frame.position->size(), susp("position"));
   if (layout.write_velocity) {
-    if (frame.velocity == nullptr) fail(path, susp("velocity"), "frame without velocities");
-    check_size(frame.velocity->size(), susp("velocity"));
+    if (spheres ? frame.velocity6 == nullptr : frame.velocity == nullptr)
+      fail(path, susp("velocity"), "frame without velocities");
+    check_size(spheres ? frame.velocity6->size() : frame.velocity->size(), susp("velocity"));
   }
-  if (want_images && frame.image == nullptr && frame.unwrapped == nullptr)
+  if (want_images &&
+      (spheres ? frame.image3 == nullptr : frame.image == nullptr && frame.unwrapped == nullptr))
     fail(path, susp("image"), "images were written at frame 0 but are missing now");
   if (frame.image != nullptr) check_size(frame.image->size(), susp("image"));
+  if (frame.image3 != nullptr) check_size(frame.image3->size(), susp("image"));
+  if (spheres && !(frame.lz > 0.0))
+    fail(path, susp("box/edges"), fmt::format("invalid box lz = {}", frame.lz));
   if (want_unwrapped) {
     if (frame.unwrapped == nullptr) {
       fail(path, susp("unwrapped_position"),
@@ -947,8 +966,9 @@ void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_images,
 
 void H5mdWriter::Impl::append_images(const FrameData& frame, double tilt, double ly) {
   const std::size_t n = layout.n_particles;
-  const std::vector<Vec2>& pos = *frame.position;
   const double lx = frame.lx;
+  if (layout.dimension == 3) return append_sphere_images(frame);
+  const std::vector<Vec2>& pos = *frame.position;
   // position + image . edges is continuous in time (the convention of LAMMPS and GSD): the
   // engine's counts of the images crossed, re-expressed for the reduced tilt of `edges`
   // (tilt = offset - m lx adds m to the x count of each y image). It equals the unwrapped
@@ -975,8 +995,34 @@ void H5mdWriter::Impl::append_images(const FrameData& frame, double tilt, double
   unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), path);
 }
 
+// The images of spheres: x and y as for discs (the counts of the images crossed, re-expressed
+// for the reduced tilt), z as crossed.
+void H5mdWriter::Impl::append_sphere_images(const FrameData& frame) {
+  const std::size_t n = layout.n_particles;
+  std::vector<std::int32_t> img(3 * n);
+  const double m_tilt = layout.lees_edwards ? std::round(frame.tilt / frame.lx) : 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [ix, iy, iz] = (*frame.image3)[i];
+    img[3 * i] = static_cast<std::int32_t>(ix + static_cast<int>(m_tilt) * iy);
+    img[3 * i + 1] = static_cast<std::int32_t>(iy);
+    img[3 * i + 2] = static_cast<std::int32_t>(iz);
+  }
+  image->append(H5T_NATIVE_INT32, img.data(), path);
+}
+
 void H5mdWriter::Impl::append_velocity(const FrameData& frame) {
   const std::size_t n = layout.n_particles;
+  if (layout.dimension == 3) {
+    std::vector<double> u(3 * n), omega(3 * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        u[3 * i + c] = (*frame.velocity6)[i](c);
+        omega[3 * i + c] = (*frame.velocity6)[i](3 + c);
+      }
+    velocity.append(H5T_NATIVE_DOUBLE, u.data(), path);
+    angular_velocity.append(H5T_NATIVE_DOUBLE, omega.data(), path);
+    return;
+  }
   std::vector<double> buf(2 * n);
   const auto& v = *frame.velocity;
   std::vector<double> omega(n);
@@ -1009,30 +1055,38 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   Impl& m = *impl_;
   if (m.frames_closed) throw std::logic_error("H5mdWriter: write_frame after write_table");
   const std::size_t n = m.layout.n_particles;
-  const bool want_images =
-      m.frames == 0 ? frame.image != nullptr || frame.unwrapped != nullptr : m.image.has_value();
+  const bool want_images = m.frames == 0 ? frame.image != nullptr || frame.unwrapped != nullptr ||
+                                               frame.image3 != nullptr
+                                         : m.image.has_value();
   const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
   m.check_frame(frame, want_images, want_unwrapped);
   if (m.frames == 0 && want_images) m.create_images(want_unwrapped);
 
-  const std::vector<Vec2>& pos = *frame.position;
+  const auto dim = static_cast<std::size_t>(m.layout.dimension);
+  std::vector<double> buf(dim * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < dim; ++c)
+      buf[dim * i + c] = dim == 3 ? (*frame.position3)[i](static_cast<Eigen::Index>(c))
+                                  : (*frame.position)[i](static_cast<Eigen::Index>(c));
   const double lx = frame.lx;
   const double tilt = m.layout.lees_edwards ? reduced_tilt(frame.tilt, lx) : 0.0;
   double ly = frame.ly;
   if (!m.layout.lees_edwards) {
     // Placeholder: tall enough that a tool taking y as periodic anyway finds no false contact.
-    double lo = pos[0].y(), hi = pos[0].y();
-    for (const Vec2& x : pos) lo = std::min(lo, x.y()), hi = std::max(hi, x.y());
+    double lo = buf[1], hi = buf[1];
+    for (std::size_t i = 0; i < n; ++i)
+      lo = std::min(lo, buf[dim * i + 1]), hi = std::max(hi, buf[dim * i + 1]);
     ly = hi - lo + 2.0 * m.max_diameter;
   }
 
   const std::int64_t st64 = frame.step;
   m.step.append(H5T_NATIVE_INT64, &st64, m.path);
   m.time.append(H5T_NATIVE_DOUBLE, &frame.time, m.path);
-  const double edges[4] = {lx, 0.0, tilt, ly};  // rows: the edge vectors (lx, 0) and (tilt, ly)
-  m.edges.append(H5T_NATIVE_DOUBLE, edges, m.path);
-  std::vector<double> buf(2 * n);
-  for (std::size_t i = 0; i < n; ++i) buf[2 * i] = pos[i].x(), buf[2 * i + 1] = pos[i].y();
+  // Rows: the edge vectors (lx, 0) and (tilt, ly); of spheres (lx, 0, 0), (tilt, ly, 0) and
+  // (0, 0, lz).
+  const double edges2[4] = {lx, 0.0, tilt, ly};
+  const double edges3[9] = {lx, 0.0, 0.0, tilt, ly, 0.0, 0.0, 0.0, frame.lz};
+  m.edges.append(H5T_NATIVE_DOUBLE, dim == 3 ? edges3 : edges2, m.path);
   m.position.append(H5T_NATIVE_DOUBLE, buf.data(), m.path);
   if (m.image) m.append_images(frame, tilt, ly);
   if (m.layout.write_velocity) m.append_velocity(frame);

@@ -287,6 +287,11 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
         "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
         "and summary.json, read by tools/channel_table.py",
         dir.string()));
+  if (cfg.scene.dimension == 3)
+    throw ConfigError(fmt::format(
+        "{}: a run of spheres (scene.dimension = 3) is analysed while it runs (summary.json, "
+        "analysis.h5); `analyse` recomputes runs of discs only",
+        dir.string()));
   // The measured window: frames from the detection of steady state (pressure cell) or after
   // the transient (simple shear), the same test the observers applied while running.
   const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state();

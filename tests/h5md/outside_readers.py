@@ -17,7 +17,10 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
 5. the LAMMPS dump export (tools/h5md_to_lammps.py) read by MDAnalysis: positions, velocities and
    box as h5py reads them, the unwrapped positions continuous;
 6. storage: per-frame series shuffled and deflated, no unwrapped_position where it is
-   position + image . edges.
+   position + image . edges;
+7. a run of spheres (scene.dimension = 3): the H5MD checker passes on its 3D layout, and its GSD
+   export is a 3D box (Lx, Ly, Lz) with every sphere inside it and position + image . box
+   continuous in time over its x crossings.
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -89,6 +92,25 @@ frame_strain = 0.01
 """
 GENUINE = 0.1  # d: health.max_overlap, the largest overlap a run may have
 failures = []
+
+
+SPHERES = """[scene]
+type = "pressure_shear"
+dimension = 3
+[particles]
+N = 64
+[flow]
+J = 3e-2
+[contact]
+ktilde = 1e3
+[run]
+strain = 1.5
+seed = 5
+[analysis]
+diffusion = false
+[output]
+frame_strain = 0.02
+"""
 
 
 def expect(ok, what):
@@ -402,6 +424,41 @@ def check_live_reading(binary, root, work):
     expect(proc.returncode == 128 + signal.SIGTERM, f"the run stopped by SIGTERM (exit {proc.returncode})")
 
 
+def check_gsd_spheres(root, traj):
+    import gsd.hoomd
+
+    out = traj.with_suffix(".gsd")
+    subprocess.run([sys.executable, str(root / "tools" / "h5md_to_gsd.py"), str(traj), "--out", str(out)],
+                   check=True, capture_output=True)
+    with h5py.File(traj, "r") as f:
+        edges = f["particles/suspension/box/edges/value"][()]
+    try:
+        traj_gsd = gsd.hoomd.open(name=str(out), mode="r")
+    except ValueError:
+        traj_gsd = gsd.hoomd.open(name=str(out), mode="rb")
+    box_ok, inside, jump, crossings, prev = True, True, 0.0, 0, None
+    with traj_gsd as t:
+        expect(len(t) == len(edges), f"spheres: GSD holds all {len(edges)} frames")
+        for k, fr in enumerate(t):
+            lx, ly, lz, xy = (float(x) for x in fr.configuration.box[:4])
+            box_ok &= bool(fr.configuration.dimensions == 3 and np.isclose(lx, edges[k, 0, 0])
+                           and np.isclose(lz, edges[k, 2, 2]) and xy == 0)
+            r = fr.particles.position.astype(np.float64)
+            im = fr.particles.image.astype(np.int64)
+            inside &= bool(np.all(np.abs(r[:, 0]) <= 0.5 * lx + 1e-4) and np.all(np.abs(r[:, 2]) <= 0.5 * lz + 1e-4))
+            u = r + im[:, [0]] * np.array([lx, 0, 0]) + im[:, [1]] * np.array([xy * ly, ly, 0]) \
+                + im[:, [2]] * np.array([0, 0, lz])
+            if prev is not None:
+                jump = max(jump, float(np.abs(u - prev).max()))
+            crossings = max(crossings, int(np.abs(im[:, 0]).sum()))
+            prev = u
+    expect(box_ok, "spheres: every GSD frame is a 3D box with the H5MD Lx and Lz")
+    expect(inside, "spheres: every sphere lies inside the GSD box in x and z")
+    expect(crossings > 0 and jump < 0.25 * float(edges[0, 0, 0]),
+           f"spheres: position + image . box continuous ({crossings} x image counts, largest step "
+           f"between frames {jump:.3g} d)")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -429,6 +486,10 @@ def main():
     else:
         check_gsd(args.root, simple, True)
         check_gsd(args.root, pressure, False)
+    spheres = run(args.bin, args.work, "spheres", SPHERES)
+    check_conformance(spheres, args.work)
+    if "gsd" in sys.modules:
+        check_gsd_spheres(args.root, spheres)
     long = run(args.bin, args.work, "simple_shear_long", LONG)
     check_continuity(args.root, long)
     try:

@@ -1,19 +1,24 @@
 // A run of spheres (scene.dimension = 3) through the same run as the discs: the configuration
 // selects it, the pressure cell of spheres carries P Lx Lz on its floating wall at every held
-// step, the observers measure phi as a volume fraction, and a run extended from its end state
-// is the longer run to the bit (the checkpoint holds the spheres' whole state: positions,
+// step, the observers measure phi as a volume fraction, the trajectory holds 3D frames and a
+// 3 x 3 box, and a run extended from its end state (its trajectory cut back and continued) is
+// the longer run to the bit (the checkpoint holds the spheres' whole state: positions,
 // unwrapped positions, tangential spring vectors, the observers' accumulators).
 #include <gtest/gtest.h>
+#include <hdf5.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/engine.hpp"
 #include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/io/summary_keys.hpp"
+#include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/run.hpp"
 
 namespace sheardiff {
@@ -33,7 +38,6 @@ Config sphere_cell(double strain) {
   c.run.strain = strain;
   c.run.seed = 5;
   c.steady.window = 0.3;
-  c.output.trajectory = false;
   c.output.frame_strain = 0.02;
   c.output.checkpoint_strain = 0.25;
   c.analysis.msd_window_lo = 0.05;
@@ -43,9 +47,69 @@ Config sphere_cell(double strain) {
   return c;
 }
 
+std::vector<hsize_t> shape(hid_t file, const std::string& name) {
+  const hid_t ds = H5Dopen2(file, name.c_str(), H5P_DEFAULT);
+  const hid_t space = H5Dget_space(ds);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  H5Sclose(space);
+  H5Dclose(ds);
+  return dims;
+}
+
+// H5MD of spheres: (frames, N, 3) positions, velocities, angular velocities and image counts,
+// and a 3 x 3 box whose last row is (0, 0, lz), periodic in x and z.
+void expect_trajectory_of_spheres(const fs::path& file, const nlohmann::json& js) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const std::string g = "/particles/suspension/";
+  const std::vector<hsize_t> pos = shape(f, g + "position/value");
+  ASSERT_EQ(pos.size(), 3u);
+  const hsize_t frames = pos[0], n = pos[1];
+  EXPECT_GT(frames, 10u);
+  EXPECT_EQ(pos[2], 3u);
+  EXPECT_EQ(n, js[summary_key::N].get<hsize_t>() + 2 * 36);  // 6 x 6 spheres in each wall
+  for (const char* e : {"velocity/value", "angular_velocity/value", "image/value"})
+    EXPECT_EQ(shape(f, g + e), (std::vector<hsize_t>{frames, n, 3})) << e;
+  EXPECT_EQ(shape(f, g + "box/edges/value"), (std::vector<hsize_t>{frames, 3, 3}));
+  const auto read = [&](const std::string& name, hid_t type, auto& out) {
+    const hid_t ds = H5Dopen2(f, (g + name).c_str(), H5P_DEFAULT);
+    H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data());
+    H5Dclose(ds);
+  };
+  std::vector<double> edges(9 * frames), position(3 * n * frames);
+  std::vector<int> image(3 * n * frames);
+  read("box/edges/value", H5T_NATIVE_DOUBLE, edges);
+  read("position/value", H5T_NATIVE_DOUBLE, position);
+  read("image/value", H5T_NATIVE_INT, image);
+  H5Fclose(f);
+  const double* last = &edges[9 * (frames - 1)];
+  EXPECT_EQ(last[0], js[summary_key::lx].get<double>());
+  EXPECT_EQ(last[8], last[0]);  // lz = lx
+  for (int k : {1, 2, 5, 6, 7}) EXPECT_EQ(last[k], 0.0) << k;
+  // position + image . edges is continuous: no sphere moves half a cell between two frames
+  // 0.02 strain apart (the spheres near the top wall cross x several times in the run).
+  double largest_jump = 0.0;
+  int crossings = 0;
+  for (hsize_t t = 1; t < frames; ++t)
+    for (hsize_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const auto at = [&](hsize_t frame) {
+          const hsize_t k = 3 * (n * frame + i);
+          const double* e = &edges[9 * frame];
+          return position[k + c] + image[k] * e[c] + image[k + 1] * e[3 + c] +
+                 image[k + 2] * e[6 + c];
+        };
+        largest_jump = std::max(largest_jump, std::abs(at(t) - at(t - 1)));
+        crossings += image[3 * (n * t + i) + c] != image[3 * (n * (t - 1) + i) + c];
+      }
+  EXPECT_GT(crossings, 0);
+  EXPECT_LT(largest_jump, 0.25 * last[0]);
+}
+
 TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
   const std::string base = "[scene]\ntype = \"pressure_shear\"\ndimension = 3\n";
-  const Config c = parse_config(base + "[output]\ntrajectory = false\n", "t.toml");
+  const Config c = parse_config(base, "t.toml");
   EXPECT_EQ(c.scene.dimension, 3);
   validate_run_inputs(c, "t.toml");
   // Each refusal names the key and what is allowed.
@@ -57,9 +121,8 @@ TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   };
-  refused(base, "output.trajectory");
-  refused("[scene]\ntype = \"simple_shear\"\ndimension = 3\n[output]\ntrajectory = false\n",
-          "scene.dimension");
+  refused(base + "[output]\ncontacts = true\n", "output.contacts");
+  refused("[scene]\ntype = \"simple_shear\"\ndimension = 3\n", "scene.dimension");
   refused("[scene]\ntype = \"pressure_shear\"\ndimension = 4\n", "scene.dimension");
   // A cell of 8 spheres (2 x 2 sites, 3 d wide) is narrower than two neighbour cut-offs.
   Config narrow = c;
@@ -85,6 +148,14 @@ TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {
   // mean over the measured contacts stays within a few of that (measured: 2.1e-3 d).
   EXPECT_LT(js[summary_key::mean_overlap].get<double>(), 5e-3);
   EXPECT_TRUE(std::isfinite(js[summary_key::shear_stress].get<double>()));
+  expect_trajectory_of_spheres(dir / "trajectory.h5", js);
+  // `analyse` recomputes runs of discs: a run of spheres is refused, naming why.
+  try {
+    reanalyse_run(dir);
+    ADD_FAILURE() << "analyse accepted a run of spheres";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.dimension = 3"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
 }
 

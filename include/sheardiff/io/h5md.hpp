@@ -21,9 +21,10 @@ struct TrajectoryLayout {
   std::vector<double> diameter;          // size n_particles
   std::vector<int> motion;               // 0 mobile, 1 fixed wall, 2 floating wall
   double lx = 1, ly = 1;                 // initial box edges
+  int dimension = 2;                     // 2: discs; 3: spheres, periodic in z
   bool lees_edwards = false;             // y boundary: "periodic" if true, else "none"
-  bool write_velocity = true;            // write velocity (u_x,u_y) and angular_velocity (omega_z)
-  bool write_contacts = false;           // write /connectivity/contacts every frame
+  bool write_velocity = true;            // write velocity and angular_velocity (omega_z or omega)
+  bool write_contacts = false;           // write /connectivity/contacts every frame (discs)
   std::vector<std::string> observables;  // names of scalar observables written per frame
   // H5MD unit strings in the project's units (docs/trajectory.md), same order as observables;
   // empty: every observable is dimensionless ("1").
@@ -47,6 +48,13 @@ struct FrameData {
   const std::vector<Vec3>* velocity = nullptr;  // (u_x,u_y,omega), required if write_velocity
   const ContactNetwork* contacts = nullptr;     // required if write_contacts
   std::vector<double> observables;              // same order as layout.observables
+  // Spheres (layout.dimension = 3), in place of position, image and velocity (unwrapped
+  // positions are not taken: position + image . edges is the unwrapped one without
+  // Lees-Edwards, and image counts are required with it).
+  double lz = 1;  // the periodic depth
+  const std::vector<Space3>* position3 = nullptr;
+  const std::vector<std::array<int, 3>>* image3 = nullptr;
+  const std::vector<Vec6>* velocity6 = nullptr;  // (u, omega)
 };
 
 class H5mdWriter {
