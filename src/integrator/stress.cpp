@@ -14,6 +14,7 @@ StressSample average(const StressSample& a, const StressSample& b) {
   m.sxx = 0.5 * (a.sxx + b.sxx);
   m.sxy = 0.5 * (a.sxy + b.sxy);
   m.syy = 0.5 * (a.syy + b.syy);
+  m.szz = 0.5 * (a.szz + b.szz);
   m.max_overlap = std::max(a.max_overlap, b.max_overlap);
   m.mean_overlap = 0.5 * (a.mean_overlap + b.mean_overlap);
   m.top_wall_fx = 0.5 * (a.top_wall_fx + b.top_wall_fx);
@@ -40,6 +41,7 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
     s.sxx -= l * t.g.n.x() * fj.x();
     s.syy -= l * t.g.n.y() * fj.y();
     s.sxy -= 0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x());
+    if constexpr (D::space == 3) s.szz -= l * t.g.n.z() * fj.z();
     if (contact) {
       ++s.contacts;
       const double ov = std::max(t.g.overlap(), 0.0);
@@ -64,6 +66,8 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
   s.sxx /= area;
   s.syy /= area;
   s.sxy /= area;
+  s.szz /= area;
+  s.spheres = D::space == 3;
   s.mean_overlap = s.contacts ? overlap_sum / s.contacts : 0.0;
   return s;
 }

@@ -85,7 +85,9 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "sigma_xy of the pair forces, positive when the suspension resists the shear; null if "
             "the run ended before averaged_from_strain"},
            {sk::pressure, "P",
-            "particle pressure -(sigma_xx + sigma_yy) / 2 of the pair forces; null as above"},
+            "particle pressure -(sigma_xx + sigma_yy) / 2 of the pair forces (spheres: the trace "
+            "over 3); "
+            "null as above"},
            {sk::viscosity, "eta",
             "shear_stress / gammadot with gammadot = J; in a channel gammadot is the Poiseuille "
             "wall shear rate 6 <u> / H, so this number has no rheological meaning there; null as "
@@ -201,7 +203,9 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "array: sigma_xy of the pair forces, each pair in the bin of its midpoint, over the "
             "bin's volume Lx bin l_z"},
            {sk::profile_pressure, "P",
-            "array: -(sigma_xx + sigma_yy) / 2 of the pair forces, binned the same way"},
+            "array: -(sigma_xx + sigma_yy) / 2 of the pair forces (spheres: the trace over 3), "
+            "binned "
+            "the same way"},
            {sk::bulk_shear_rate_ratio, "1",
             "slope of a least-squares line through u_x(y) over the bins at least "
             "`observables.wall_exclusion` from both walls, over the imposed gammadot (1 for a "

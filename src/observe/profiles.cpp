@@ -77,7 +77,10 @@ void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, d
     const double l = pr.history.touching ? t.g.r : t.g.s;
     const double sxx = -l * t.g.n.x() * fj.x(), syy = -l * t.g.n.y() * fj.y();
     sxy_[c] += weight * -0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x()) / volume;
-    sp_[c] += weight * -0.5 * (sxx + syy) / volume;
+    // The pressure of the trace: two normal stresses of discs, three of spheres.
+    double pressure = -0.5 * (sxx + syy);
+    if constexpr (D::space == 3) pressure = -(sxx + syy - l * t.g.n.z() * fj.z()) / 3.0;
+    sp_[c] += weight * pressure / volume;
   }
 }
 

@@ -66,6 +66,18 @@ TEST(SphereDynamics, SpherePressedOnAWallSphereSettlesAtTheOverlapFOverKn) {
     // Pressed along the line of centres, it neither slides off nor turns.
     EXPECT_LT((r.normalized() - n).norm(), 1e-9) << to_string(type);
     EXPECT_LT(d.particles().velocity[0].tail<3>().norm(), 1e-9) << to_string(type);
+    // The pair stress of the one contact is -(r / V) n (x) F n: its normal components go as
+    // n_a^2 (sigma_zz / sigma_xx = n_z^2 / n_x^2 = 9), and the pressure of spheres is the trace
+    // over 3 (a disc's (xx + yy) / 2 would miss sigma_zz).
+    const StressSample st = measure_stress(d, integrator->velocities(), 1.0);
+    EXPECT_NEAR(st.szz / st.sxx, n.z() * n.z() / (n.x() * n.x()), 1e-6) << to_string(type);
+    EXPECT_NEAR(st.syy / st.sxx, n.y() * n.y() / (n.x() * n.x()), 1e-6) << to_string(type);
+    EXPECT_DOUBLE_EQ(st.pressure(), -(st.sxx + st.syy + st.szz) / 3.0) << to_string(type);
+    // And its size is r F / (3 V), V = Lx H Lz (this test's H, the top "wall" being empty, is
+    // a signed placeholder: compared in magnitude).
+    const double volume = std::abs(box.lx * box.lz * d.height());
+    EXPECT_NEAR(std::abs(st.pressure()) * 3.0 * volume / (r.norm() * force), 1.0, 1e-6)
+        << to_string(type);
   }
 }
 

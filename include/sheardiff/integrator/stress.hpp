@@ -6,10 +6,13 @@ namespace sheardiff {
 
 // Pair stress and contact statistics of one configuration (docs/model.md section 9):
 // sigma = -(1 / (area lz)) sum over pairs of sym(l n (x) F_j), l = r in contact, s otherwise,
-// F_j the pair force on j. Tension positive: pressure = -(sigma_xx + sigma_yy) / 2.
+// F_j the pair force on j. Tension positive: pressure = -(sigma_xx + sigma_yy) / 2 of discs,
+// -(sigma_xx + sigma_yy + sigma_zz) / 3 of spheres.
 struct StressSample {
   double sxx = 0, sxy = 0, syy = 0;
-  double pressure() const { return -0.5 * (sxx + syy); }
+  double szz = 0;  // spheres only
+  bool spheres = false;
+  double pressure() const { return spheres ? -(sxx + syy + szz) / 3.0 : -0.5 * (sxx + syy); }
   double shear_stress() const { return sxy; }
   int contacts = 0;
   double max_overlap = 0.0;
