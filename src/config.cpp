@@ -196,7 +196,14 @@ const std::vector<KeySpec>& schema() {
                      "Area fraction of the initial random placement (above ~0.55 it is reached "
                      "by compression with a soft repulsion)."));
     s.push_back(real("particles.aspect", &C::particles, &C::ParticlesCfg::aspect, 0.05, 20.0, false,
-                     "", "Initial cell height over width, Ly/Lx."));
+                     "",
+                     "Initial cell height over width, Ly/Lx (spheres: the starting lattice's "
+                     "height over its width, Lx = Lz)."));
+    s.push_back(real("particles.phi_init_spheres", &C::particles,
+                     &C::ParticlesCfg::phi_init_spheres, 0.0, 0.55, false, "",
+                     "Spheres (scene.dimension = 3): volume fraction of the random start between "
+                     "the walls, reached by compression in y with a soft repulsion; 0 = a loose "
+                     "lattice (volume fraction ~0.2, long to compact)."));
     s.push_back(text("particles.init_file", &C::particles, &C::ParticlesCfg::init_file,
                      "Optional initial configuration: an H5MD file (`.h5`) or a plain table "
                      "`x y diameter`; empty = random placement. Relative paths are taken from "

@@ -33,7 +33,8 @@ struct Config {
     MixRule mix = MixRule::Volume;  // the seed (Appendix A): "mixed in equal volume"
     double size_ratio = 1.4;
     double phi_init = 0.7;
-    double aspect = 1.0;  // Ly / Lx of the initial cell
+    double aspect = 1.0;             // Ly / Lx of the initial cell
+    double phi_init_spheres = 0.45;  // volume fraction of a random start of spheres
     std::string init_file;
     std::int64_t init_frame = -1;
   } particles;

@@ -1,5 +1,6 @@
-// The pressure cell of spheres (scene/scene.hpp): a loose lattice of bidisperse spheres between
-// two rough walls of frozen spheres, periodic in x and z.
+// The pressure cell of spheres (scene/scene.hpp): bidisperse spheres (a random start compressed
+// to particles.phi_init_spheres, or a loose lattice) between two rough walls of frozen spheres,
+// periodic in x and z.
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -31,18 +32,34 @@ void add_wall(Particles3& p, std::vector<int>& ids, double l, double base, int s
     }
 }
 
-// Lattice sites one largest diameter plus a margin apart, per_side x per_side in x-z.
+// Lattice sites one largest diameter plus a margin apart, per_side x per_side in x-z, with
+// about particles.aspect times per_side layers in y (per_side^2 layers = N).
 double site_spacing(const Config& cfg) {
   return std::max(1.0, cfg.particles.size_ratio) + 0.1;
 }
 int sites_per_side(const Config& cfg) {
-  return std::max(2,
-                  static_cast<int>(std::lround(std::cbrt(static_cast<double>(cfg.particles.n)))));
+  const double n = static_cast<double>(cfg.particles.n);
+  return std::max(2, static_cast<int>(std::lround(std::cbrt(n / cfg.particles.aspect))));
+}
+
+// The random start at particles.phi_init_spheres (setup/sphere_packing.cpp).
+SpherePacking random_start(const Config& cfg) {
+  return random_sphere_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
+                               cfg.particles.phi_init_spheres, cfg.particles.aspect,
+                               static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
 }
 
 }  // namespace
 
 PlannedCell pressure_shear_3d_cell(const Config& cfg) {
+  if (cfg.particles.phi_init_spheres > 0.0) {
+    // The random start's cell (sphere_packing.cpp), without placing the spheres.
+    double volume = 0.0;
+    for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio))
+      volume += kPi / 6.0 * std::pow(s == 0 ? 1.0 : cfg.particles.size_ratio, 3);
+    const double l = std::cbrt(volume / cfg.particles.phi_init_spheres / cfg.particles.aspect);
+    return {.lx = l, .ly = cfg.particles.aspect * l, .lz = l};
+  }
   const int per_side = sites_per_side(cfg);
   const double spacing = site_spacing(cfg), l = per_side * spacing;
   const auto layers =
@@ -53,36 +70,47 @@ PlannedCell pressure_shear_3d_cell(const Config& cfg) {
 Scene3 build_pressure_shear_3d(const Config& cfg) {
   const std::int64_t n = cfg.particles.n;
   const double ratio = cfg.particles.size_ratio;
-  std::vector<int> species = bidisperse_species(n, cfg.particles.mix, ratio);
   std::mt19937_64 rng(static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
-  std::shuffle(species.begin(), species.end(), rng);
-  // As many layers of sites in y as it takes; each centre jittered by up to 0.02 spacing per
-  // axis, so that no two spheres touch (1.5 - 0.06 > 1.4 at the default size ratio).
-  const double spacing = site_spacing(cfg);
-  const int per_side = sites_per_side(cfg);
-  const auto layers = static_cast<int>((n + per_side * per_side - 1) / (per_side * per_side));
-  const double l = per_side * spacing;
-  std::uniform_real_distribution<double> jitter(-0.02, 0.02);
-
   Scene3 sc;
   Particles3& p = sc.particles;
   p.resize(static_cast<std::size_t>(n));
   p.n_mobile = static_cast<std::size_t>(n);
-  for (std::int64_t k = 0; k < n; ++k) {
-    const auto site = static_cast<int>(k);
-    const int layer = site / (per_side * per_side), ix = (site / per_side) % per_side,
-              iz = site % per_side;
-    p.position[k] =
-        Space3((ix + 0.5 + jitter(rng)) * spacing, (layer + 1.0 + jitter(rng)) * spacing,
-               (iz + 0.5 + jitter(rng)) * spacing);
-    p.species[k] = species[k];
-    p.radius[k] = species[k] == 1 ? 0.5 * ratio : 0.5;
+  double l = 0.0, top = 0.0;
+  if (cfg.particles.phi_init_spheres > 0.0) {
+    // Random spheres between the walls' surfaces y = 0 and y = top.
+    const SpherePacking pk = random_start(cfg);
+    for (std::int64_t k = 0; k < n; ++k) {
+      p.position[k] = pk.position[k];
+      p.species[k] = pk.species[k];
+      p.radius[k] = pk.radius[k];
+    }
+    l = pk.l, top = pk.ly;
+  } else {
+    std::vector<int> species = bidisperse_species(n, cfg.particles.mix, ratio);
+    std::shuffle(species.begin(), species.end(), rng);
+    // As many layers of sites in y as it takes; each centre jittered by up to 0.02 spacing per
+    // axis, so that no two spheres touch (1.5 - 0.06 > 1.4 at the default size ratio).
+    const double spacing = site_spacing(cfg);
+    const int per_side = sites_per_side(cfg);
+    const auto layers = static_cast<int>((n + per_side * per_side - 1) / (per_side * per_side));
+    l = per_side * spacing;
+    std::uniform_real_distribution<double> jitter(-0.02, 0.02);
+    for (std::int64_t k = 0; k < n; ++k) {
+      const auto site = static_cast<int>(k);
+      const int layer = site / (per_side * per_side), ix = (site / per_side) % per_side,
+                iz = site % per_side;
+      p.position[k] =
+          Space3((ix + 0.5 + jitter(rng)) * spacing, (layer + 1.0 + jitter(rng)) * spacing,
+                 (iz + 0.5 + jitter(rng)) * spacing);
+      p.species[k] = species[k];
+      p.radius[k] = species[k] == 1 ? 0.5 * ratio : 0.5;
+    }
+    // The lowest layer sits one spacing above the bottom wall's surface (y = 0), the top wall
+    // one spacing above the highest layer.
+    top = (layers + 1.0) * spacing;
   }
-  // The lowest layer sits one spacing above the bottom wall's surface (y = 0), the top wall one
-  // spacing above the highest layer.
   WallBodies walls;
   walls.top_role = WallRole::Floating;
-  const double top = (layers + 1.0) * spacing;
   add_wall(p, walls.bottom, l, 0.0, -1, cfg.walls.jitter, Motion::FixedWall, rng);
   add_wall(p, walls.top, l, top, +1, cfg.walls.jitter, Motion::FloatingWall, rng);
   p.unwrapped = p.position;

@@ -146,6 +146,7 @@ struct SphereCell {
   static Config cell_config(std::int64_t seed) {
     Config c;
     c.particles.n = 48;
+    c.particles.phi_init_spheres = 0.0;  // the loose lattice
     c.flow.j = 1e-2;
     c.contact.ktilde = 1e4;
     c.run.seed = seed;

@@ -33,6 +33,7 @@ Config sphere_cell(double strain) {
   c.scene.type = "pressure_shear";
   c.scene.dimension = 3;
   c.particles.n = 64;
+  c.particles.phi_init_spheres = 0.0;  // the loose lattice: 4 x 4 sites per layer, 4 layers
   c.flow.j = 3e-2;
   c.contact.ktilde = 1e3;
   c.run.strain = strain;

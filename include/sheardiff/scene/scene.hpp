@@ -44,12 +44,17 @@ struct Scene3 {
 };
 
 // The pressure cell of spheres: particles.N bidisperse spheres (d and particles.size_ratio d,
-// mixed by particles.mix) on a jittered cubic lattice loose enough for the largest (volume
-// fraction ~0.3), between two rough walls of frozen spheres of diameter d (a square lattice in
-// x-z, centres jittered in y by walls.jitter radii), periodic in x and z (lx = lz); the bottom
-// wall is fixed, the top wall floats under P lx lz (P = 1) and is driven at the imposed shear's
-// velocity gammadot = flow.J at its height. The packing compacts under the wall to its
-// steady volume fraction. Reproducible for run.seed.
+// mixed by particles.mix) placed at random and compressed in y to the volume fraction
+// particles.phi_init_spheres (or, with 0, on a jittered cubic lattice loose enough for the
+// largest, volume fraction ~0.2), in a cell particles.aspect times as high as wide, between two
+// rough walls of frozen spheres of diameter d (a square lattice in x-z, centres jittered in y
+// by walls.jitter radii), periodic in x and z (lx = lz); the bottom wall is fixed, the top wall
+// floats under P lx lz (P = 1) and is driven at the imposed shear's velocity gammadot = flow.J
+// at its height. The packing dilates or compacts under the wall to its steady volume fraction.
+// Reproducible for run.seed.
 Scene3 build_pressure_shear_3d(const Config& cfg);
+// Its cell before the spheres are placed (checked before any work): lx = lz and the height
+// between the walls' surfaces.
+PlannedCell pressure_shear_3d_cell(const Config& cfg);
 
 }  // namespace sheardiff
