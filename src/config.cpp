@@ -201,9 +201,10 @@ const std::vector<KeySpec>& schema() {
                      "height over its width, Lx = Lz)."));
     s.push_back(real("particles.phi_init_spheres", &C::particles,
                      &C::ParticlesCfg::phi_init_spheres, 0.0, 0.55, false, "",
-                     "Spheres (scene.dimension = 3): volume fraction of the random start between "
-                     "the walls, reached by compression in y with a soft repulsion; 0 = a loose "
-                     "lattice (volume fraction ~0.2, long to compact)."));
+                     "Spheres (scene.dimension = 3): volume fraction of the random start, reached "
+                     "by compression with a soft repulsion; the pressure cell dilates or compacts "
+                     "from it (0 = a loose lattice, volume fraction ~0.2, long to compact), simple "
+                     "shear keeps it."));
     s.push_back(text("particles.init_file", &C::particles, &C::ParticlesCfg::init_file,
                      "Optional initial configuration: an H5MD file (`.h5`) or a plain table "
                      "`x y diameter`; empty = random placement. Relative paths are taken from "
@@ -499,6 +500,10 @@ void check_spheres(const Config& c, const std::string& origin) {
   if (!c.particles.init_file.empty())
     fail(origin, "particles.init_file",
          "a scene of spheres (scene.dimension = 3) places its own spheres; leave it empty");
+  if (scene_kind(c.scene.type).periodic_y && !(c.particles.phi_init_spheres > 0.0))
+    fail(origin, "particles.phi_init_spheres",
+         "a periodic cell of spheres is sheared at the volume fraction it starts at: allowed "
+         "(0, 0.55]");
   if (c.output.trajectory && c.output.contacts)
     fail(origin, "output.contacts",
          "the contact network of spheres is not written (its tangential forces are vectors); set "

@@ -45,7 +45,7 @@ int sites_per_side(const Config& cfg) {
 // The random start at particles.phi_init_spheres (setup/sphere_packing.cpp).
 SpherePacking random_start(const Config& cfg) {
   return random_sphere_packing(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
-                               cfg.particles.phi_init_spheres, cfg.particles.aspect,
+                               cfg.particles.phi_init_spheres, cfg.particles.aspect, false,
                                static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
 }
 

@@ -24,14 +24,21 @@ std::optional<ConfigProblem> check_channel(const Config& cfg);
 double channel_frame_spacing(const Config& cfg);
 PlannedCell channel_cell(const Config& cfg);
 PlannedCell pressure_shear_3d_cell(const Config& cfg);
+Scene3 build_simple_shear_3d(const Config& cfg);
+PlannedCell simple_shear_3d_cell(const Config& cfg);
 
 const std::vector<SceneKind>& scene_registry() {
   static const std::vector<SceneKind> rows = {
       {.name = "simple_shear",
-       .doc = "`simple_shear` = Lees-Edwards periodic cell at fixed area fraction and shear rate",
+       .doc =
+           "`simple_shear` = Lees-Edwards periodic cell at fixed area (discs) or volume (spheres) "
+           "fraction and shear rate",
        .build = SHEARDIFF_SCENE(build_simple_shear),
        .periodic_y = true,
-       .measures = Measures::ShearAfterTransient},
+       .measures = Measures::ShearAfterTransient,
+       .spheres = true,
+       .build_3d = SHEARDIFF_SCENE(build_simple_shear_3d),
+       .planned_cell_3d = SHEARDIFF_SCENE(simple_shear_3d_cell)},
       {.name = "pressure_shear",
        .doc = "`pressure_shear` = plane shear between rough walls, the top wall floating under "
               "the load P Lx lz (the packing dilates to phi(J))",

@@ -1,5 +1,7 @@
-// Simple shear (Lees-Edwards periodic cell at fixed area fraction and shear rate): the engine's
-// validation scene.
+// Simple shear (Lees-Edwards periodic cell at fixed area or volume fraction and shear rate): the
+// engine's validation scene, of discs or of spheres.
+#include <cmath>
+
 #include "sheardiff/scene/scene.hpp"
 #include "sheardiff/setup/random_packing.hpp"
 
@@ -18,6 +20,39 @@ Scene build_simple_shear(const Config& cfg) {
   sc.box.ly = pk.ly;
   sc.box.lees_edwards = true;
   sc.box.le_offset = pk.tilt;
+  sc.flow.gammadot = cfg.flow.j;
+  sc.flow.y0 = 0.0;
+  return sc;
+}
+
+}  // namespace sheardiff
+
+namespace sheardiff {
+
+PlannedCell simple_shear_3d_cell(const Config& cfg) {
+  // The random start's cube (sphere_packing.cpp) at the volume fraction, without placing.
+  double volume = 0.0;
+  for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio))
+    volume += kPi / 6.0 * std::pow(s == 0 ? 1.0 : cfg.particles.size_ratio, 3);
+  const double l = std::cbrt(volume / cfg.particles.phi_init_spheres / cfg.particles.aspect);
+  return {.lx = l, .ly = cfg.particles.aspect * l, .lz = l};
+}
+
+Scene3 build_simple_shear_3d(const Config& cfg) {
+  const SpherePacking pk = random_sphere_packing(
+      cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio, cfg.particles.phi_init_spheres,
+      cfg.particles.aspect, true, static_cast<std::uint64_t>(cfg.run.seed) ^ 0x51ab7c3d9e3779b9ULL);
+  Scene3 sc;
+  Particles3& p = sc.particles;
+  p.resize(pk.position.size());
+  p.n_mobile = pk.position.size();
+  p.position = pk.position;
+  p.unwrapped = pk.position;
+  p.radius = pk.radius;
+  p.species = pk.species;
+  sc.box.lx = sc.box.lz = pk.l;
+  sc.box.ly = pk.ly;
+  sc.box.lees_edwards = true;
   sc.flow.gammadot = cfg.flow.j;
   sc.flow.y0 = 0.0;
   return sc;

@@ -14,16 +14,18 @@
 namespace sheardiff {
 namespace {
 
-// Largest overlap between any two spheres, every pair by minimum image in x and z (O(N^2): an
-// independent check of the cell grid that the packing uses).
+// Largest overlap between any two spheres, every pair by minimum image in x and z (and in y over
+// periodic_ly if positive) (O(N^2): an independent check of the cell grid that the packing
+// uses).
 double largest_overlap(const std::vector<Space3>& x, const std::vector<double>& r, double l,
-                       std::size_t n) {
+                       std::size_t n, double periodic_ly = 0.0) {
   double worst = 0.0;
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = i + 1; j < n; ++j) {
       Space3 d = x[j] - x[i];
       d.x() -= l * std::round(d.x() / l);
       d.z() -= l * std::round(d.z() / l);
+      if (periodic_ly > 0.0) d.y() -= periodic_ly * std::round(d.y() / periodic_ly);
       worst = std::max(worst, r[i] + r[j] - d.norm());
     }
   return worst;
@@ -31,7 +33,7 @@ double largest_overlap(const std::vector<Space3>& x, const std::vector<double>& 
 
 TEST(SpherePacking, VolumeFractionNoOverlapsInsideTheWalls) {
   for (const double phi : {0.3, 0.5}) {
-    const SpherePacking pk = random_sphere_packing(400, MixRule::Volume, 1.4, phi, 2.0, 7);
+    const SpherePacking pk = random_sphere_packing(400, MixRule::Volume, 1.4, phi, 2.0, false, 7);
     ASSERT_EQ(pk.position.size(), 400u);
     double volume = 0.0;
     for (double a : pk.radius) volume += 4.0 / 3.0 * kPi * a * a * a;
@@ -54,10 +56,27 @@ TEST(SpherePacking, VolumeFractionNoOverlapsInsideTheWalls) {
   }
 }
 
+TEST(SpherePacking, PeriodicCellForSimpleShear) {
+  // Periodic in y too (simple shear of spheres): compressed in every direction, so the cell
+  // keeps its aspect, and no overlap across any periodic face.
+  const SpherePacking pk = random_sphere_packing(300, MixRule::Volume, 1.4, 0.5, 1.0, true, 5);
+  double volume = 0.0;
+  for (double a : pk.radius) volume += 4.0 / 3.0 * kPi * a * a * a;
+  EXPECT_NEAR(volume / (pk.l * pk.l * pk.ly), 0.5, 1e-12);
+  EXPECT_NEAR(pk.ly, pk.l, 1e-12);
+  for (const Space3& x : pk.position) {
+    ASSERT_GE(x.minCoeff(), 0.0);
+    ASSERT_LT(x.x(), pk.l);
+    ASSERT_LT(x.y(), pk.ly);
+    ASSERT_LT(x.z(), pk.l);
+  }
+  EXPECT_LT(largest_overlap(pk.position, pk.radius, pk.l, pk.position.size(), pk.ly), 1e-4);
+}
+
 TEST(SpherePacking, SpreadAcrossTheGap) {
   // Not a lattice and not piled at one wall: each third of the height holds about a third of
   // the volume (a random packing of 1000 spheres: within 0.1 of it).
-  const SpherePacking pk = random_sphere_packing(1000, MixRule::Volume, 1.4, 0.45, 1.0, 3);
+  const SpherePacking pk = random_sphere_packing(1000, MixRule::Volume, 1.4, 0.45, 1.0, false, 3);
   double third[3] = {0, 0, 0}, all = 0;
   for (std::size_t i = 0; i < pk.position.size(); ++i) {
     const double v = std::pow(pk.radius[i], 3);
@@ -68,9 +87,9 @@ TEST(SpherePacking, SpreadAcrossTheGap) {
 }
 
 TEST(SpherePacking, ReproduciblePerSeed) {
-  const auto a = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, 11);
-  const auto b = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, 11);
-  const auto c = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, 12);
+  const auto a = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, false, 11);
+  const auto b = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, false, 11);
+  const auto c = random_sphere_packing(200, MixRule::Volume, 1.4, 0.45, 1.0, false, 12);
   EXPECT_EQ(a.position, b.position);
   EXPECT_NE(a.position, c.position);
 }

@@ -57,4 +57,10 @@ Scene3 build_pressure_shear_3d(const Config& cfg);
 // between the walls' surfaces.
 PlannedCell pressure_shear_3d_cell(const Config& cfg);
 
+// Simple shear of spheres: particles.N bidisperse spheres placed at random and compressed to the
+// volume fraction particles.phi_init_spheres in a cube (particles.aspect times as high as wide),
+// periodic in x and z and Lees-Edwards periodic in y, sheared at gammadot = flow.J.
+Scene3 build_simple_shear_3d(const Config& cfg);
+PlannedCell simple_shear_3d_cell(const Config& cfg);
+
 }  // namespace sheardiff

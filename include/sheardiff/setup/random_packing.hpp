@@ -27,10 +27,10 @@ struct Packing {
 Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,
                        std::uint64_t seed);
 
-// Random non-overlapping spheres between the planes y = 0 and y = ly (centres at least a radius
-// inside), periodic in x and z over l x l, at volume fraction phi with ly = aspect l: random
-// sequential addition in a cell dilated in y, then compression in y with a soft repulsion.
-// Reproducible for a given seed.
+// Random non-overlapping spheres in an l x ly x l cell periodic in x and z, at volume fraction
+// phi with ly = aspect l: between the planes y = 0 and y = ly (centres at least a radius inside),
+// or periodic in y too. Random sequential addition in a dilated cell, then compression (in y
+// alone between walls) with a soft repulsion. Reproducible for a given seed.
 struct SpherePacking {
   std::vector<Space3> position;
   std::vector<double> radius;
@@ -38,7 +38,7 @@ struct SpherePacking {
   double l = 0, ly = 0;
 };
 SpherePacking random_sphere_packing(std::int64_t n, MixRule mix, double size_ratio, double phi,
-                                    double aspect, std::uint64_t seed);
+                                    double aspect, bool periodic_y, std::uint64_t seed);
 
 // The mobile particles of cfg: a random packing, or the configuration of particles.init_file
 // (whose overlaps are judged across y too where the scene is periodic in y).
