@@ -53,12 +53,10 @@ SpherePacking random_start(const Config& cfg) {
 
 PlannedCell pressure_shear_3d_cell(const Config& cfg) {
   if (cfg.particles.phi_init_spheres > 0.0) {
-    // The random start's cell (sphere_packing.cpp), without placing the spheres.
-    double volume = 0.0;
-    for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio))
-      volume += kPi / 6.0 * std::pow(s == 0 ? 1.0 : cfg.particles.size_ratio, 3);
-    const double l = std::cbrt(volume / cfg.particles.phi_init_spheres / cfg.particles.aspect);
-    return {.lx = l, .ly = cfg.particles.aspect * l, .lz = l};
+    const SphereCell c =
+        sphere_packing_cell(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
+                            cfg.particles.phi_init_spheres, cfg.particles.aspect);
+    return {.lx = c.l, .ly = c.ly, .lz = c.l};
   }
   const int per_side = sites_per_side(cfg);
   const double spacing = site_spacing(cfg), l = per_side * spacing;

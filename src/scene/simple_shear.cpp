@@ -30,12 +30,11 @@ Scene build_simple_shear(const Config& cfg) {
 namespace sheardiff {
 
 PlannedCell simple_shear_3d_cell(const Config& cfg) {
-  // The random start's cube (sphere_packing.cpp) at the volume fraction, without placing.
-  double volume = 0.0;
-  for (int s : bidisperse_species(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio))
-    volume += kPi / 6.0 * std::pow(s == 0 ? 1.0 : cfg.particles.size_ratio, 3);
-  const double l = std::cbrt(volume / cfg.particles.phi_init_spheres / cfg.particles.aspect);
-  return {.lx = l, .ly = cfg.particles.aspect * l, .lz = l};
+  // The random start's cell, without placing the spheres.
+  const SphereCell c =
+      sphere_packing_cell(cfg.particles.n, cfg.particles.mix, cfg.particles.size_ratio,
+                          cfg.particles.phi_init_spheres, cfg.particles.aspect);
+  return {.lx = c.l, .ly = c.ly, .lz = c.l};
 }
 
 Scene3 build_simple_shear_3d(const Config& cfg) {

@@ -6,87 +6,22 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "packing_steps.hpp"
+
 namespace sheardiff {
 
 namespace {
-
-// Uniform grid over a periodic cell, cell size >= largest diameter, for overlap searches.
-struct Grid {
-  int nx, ny;
-  double cx, cy, lx, ly;
-  std::vector<std::vector<int>> cells;
-  Grid(double lx_, double ly_, double cell)
-      : nx(std::max(1, static_cast<int>(lx_ / cell))),
-        ny(std::max(1, static_cast<int>(ly_ / cell))),
-        cx(lx_ / nx),
-        cy(ly_ / ny),
-        lx(lx_),
-        ly(ly_),
-        cells(static_cast<std::size_t>(nx) * ny) {}
-  int cell_of(const Vec2& x) const {
-    int ix = static_cast<int>(std::floor(x.x() / cx)),
-        iy = static_cast<int>(std::floor(x.y() / cy));
-    ix = ((ix % nx) + nx) % nx;
-    iy = std::clamp(((iy % ny) + ny) % ny, 0, ny - 1);
-    return iy * nx + ix;
-  }
-  void insert(int id, const Vec2& x) { cells[cell_of(x)].push_back(id); }
-  template <class F>
-  void neighbours(const Vec2& x, F&& f) const {
-    const int c = cell_of(x), ix = c % nx, iy = c / nx;
-    const int rx = nx < 3 ? 0 : 1, ry = ny < 3 ? 0 : 1;
-    for (int dy = -ry; dy <= ry; ++dy)
-      for (int dx = -rx; dx <= rx; ++dx) {
-        const int jx = (ix + dx + nx) % nx, jy = (iy + dy + ny) % ny;
-        for (int id : cells[jy * nx + jx]) f(id);
-      }
-    if (nx < 3 || ny < 3) {  // tiny cells: fall back to every particle once
-      for (int q = 0; q < static_cast<int>(cells.size()); ++q) {
-        const int qx = q % nx, qy = q / nx;
-        if (std::abs(qx - ix) <= rx && std::abs(qy - iy) <= ry) continue;
-        for (int id : cells[q]) f(id);
-      }
-    }
-  }
-};
-
-Vec2 min_image(Vec2 d, double lx, double ly, bool periodic_y) {
-  d.x() -= lx * std::round(d.x() / lx);
-  if (periodic_y) d.y() -= ly * std::round(d.y() / ly);
-  return d;
-}
 
 // Places the discs of pk (radii set) one by one at random in an lx x ly periodic cell, large
 // first; false if one found no free spot.
 bool random_sequential_addition(Packing& pk, double lx, double ly, double size_ratio,
                                 std::uint64_t seed) {
-  const auto n = pk.radius.size();
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> ux(0.0, lx), uy(0.0, ly);
   const double amax = 0.5 * std::max(1.0, size_ratio);
-  Grid grid(lx, ly, 2.0 * amax);
-  pk.position.assign(n, Vec2::Zero());
-  std::vector<std::size_t> order(n);
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = order.size() - 1 - k;
-  for (std::size_t k : order) {
-    bool placed = false;
-    for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
-      const Vec2 x(ux(rng), uy(rng));
-      bool free = true;
-      grid.neighbours(x, [&](int j) {
-        if (!free) return;
-        const Vec2 d = min_image(pk.position[j] - x, lx, ly, true);
-        if (d.norm() < pk.radius[k] + pk.radius[j]) free = false;
-      });
-      if (free) {
-        pk.position[k] = x;
-        grid.insert(static_cast<int>(k), x);
-        placed = true;
-      }
-    }
-    if (!placed) return false;
-  }
-  return true;
+  const packing::Cell<Vec2> cell{{lx, ly}, true};
+  return packing::add_sequentially(pk.position, pk.radius, cell, 2.0 * amax,
+                                   [&](std::size_t) { return Vec2(ux(rng), uy(rng)); });
 }
 
 }  // namespace
@@ -104,42 +39,8 @@ std::vector<int> bidisperse_species(std::int64_t n, MixRule mix, double size_rat
 
 double relax_overlaps(std::vector<Vec2>& position, const std::vector<double>& radius, double lx,
                       double ly, bool periodic_y, double tolerance, int max_iterations) {
-  const double amax = *std::max_element(radius.begin(), radius.end());
-  const std::size_t n = position.size();
-  std::vector<Vec2> push(n);
-  double worst = 0.0;
-  for (int it = 0; it < max_iterations; ++it) {
-    Grid grid(lx, ly, 2.0 * amax);
-    for (std::size_t i = 0; i < n; ++i) grid.insert(static_cast<int>(i), position[i]);
-    std::fill(push.begin(), push.end(), Vec2::Zero());
-    worst = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      grid.neighbours(position[i], [&](int j) {
-        if (j <= static_cast<int>(i)) return;
-        const Vec2 d = min_image(position[j] - position[i], lx, ly, periodic_y);
-        const double r = d.norm(), s = radius[i] + radius[j];
-        if (r >= s || r == 0.0) return;
-        const Vec2 nrm = d / r;
-        worst = std::max(worst, s - r);
-        push[i] -= 0.5 * (s - r) * nrm;
-        push[j] += 0.5 * (s - r) * nrm;
-      });
-    }
-    if (worst < tolerance) break;
-    for (std::size_t i = 0; i < n; ++i) {
-      // Over-relaxed steps converge faster; the cap keeps dense starts from scattering.
-      Vec2 step = 0.6 * push[i];
-      const double len = step.norm();
-      if (len > 0.1 * radius[i]) step *= 0.1 * radius[i] / len;
-      position[i] += step;
-      position[i].x() -= lx * std::floor(position[i].x() / lx);
-      if (periodic_y)
-        position[i].y() -= ly * std::floor(position[i].y() / ly);
-      else
-        position[i].y() = std::clamp(position[i].y(), radius[i], ly - radius[i]);
-    }
-  }
-  return worst;
+  return packing::relax(position, radius, packing::Cell<Vec2>{{lx, ly}, periodic_y}, tolerance,
+                        max_iterations);
 }
 
 Packing random_packing(std::int64_t n, MixRule mix, double size_ratio, double phi, double aspect,

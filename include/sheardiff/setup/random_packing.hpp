@@ -40,6 +40,14 @@ struct SpherePacking {
 SpherePacking random_sphere_packing(std::int64_t n, MixRule mix, double size_ratio, double phi,
                                     double aspect, bool periodic_y, std::uint64_t seed);
 
+// The l x aspect l x l cell random_sphere_packing fills at phi (its packing's l and ly equal
+// these to round-off), without placing the spheres: what a scene plans before it is built.
+struct SphereCell {
+  double l = 0, ly = 0;
+};
+SphereCell sphere_packing_cell(std::int64_t n, MixRule mix, double size_ratio, double phi,
+                               double aspect);
+
 // The mobile particles of cfg: a random packing, or the configuration of particles.init_file
 // (whose overlaps are judged across y too where the scene is periodic in y).
 Packing initial_packing(const struct Config& cfg, bool periodic_y);
