@@ -504,10 +504,6 @@ void check_spheres(const Config& c, const std::string& origin) {
     fail(origin, "particles.phi_init_spheres",
          "a periodic cell of spheres is sheared at the volume fraction it starts at: allowed "
          "(0, 0.55]");
-  if (c.output.trajectory && c.output.contacts)
-    fail(origin, "output.contacts",
-         "the contact network of spheres is not written (its tangential forces are vectors); set "
-         "output.contacts = false");
 }
 
 void check_combinations(const Config& c, const std::string& origin) {

@@ -130,6 +130,8 @@ void write_trajectory_frame(H5mdWriter& writer, const Config& cfg, const Running
     f.position3 = &p.position;
     if (images) f.image3 = &p.image;
     f.velocity6 = &run.sim.integrator().velocities().u;
+    if (cfg.output.contacts) contacts = contact_network(d);
+    f.contacts = &contacts;
   } else {
     f.position = &p.position;
     // Without Lees-Edwards the unwrapped position is position + image . edges: not stored twice.

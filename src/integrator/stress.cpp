@@ -126,4 +126,25 @@ ContactNetwork contact_network(const Dynamics& d) {
   return c;
 }
 
+ContactNetwork contact_network(const Dynamics3& d) {
+  ContactNetwork c;
+  c.components = 3;
+  const Particles3& p = d.particles();
+  const FrictionalContact& law = d.force_balance().contact();
+  for (const Pair3& pr : d.neighbours().pairs()) {
+    if (!pr.history.touching) continue;
+    const PairGeometry3 g =
+        PairGeometry3::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
+    if (!(g.overlap() > 0.0)) continue;
+    c.pairs.push_back({pr.i, pr.j});
+    c.normal_force.push_back(law.kn_of(g) * g.overlap());
+    // The spring on j is -kt xi (FrictionalContact::spring_force_3d), xi in the plane normal to
+    // n as the last cap left it.
+    const Space3 ft = -law.kt_of(g) * pr.history.contact.xi;
+    c.tangential_force.insert(c.tangential_force.end(), {ft.x(), ft.y(), ft.z()});
+    c.sliding.push_back(pr.history.contact.sliding ? 1 : 0);
+  }
+  return c;
+}
+
 }  // namespace sheardiff

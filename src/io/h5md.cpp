@@ -646,8 +646,6 @@ void check_layout(const fs::path& path, const TrajectoryLayout& layout) {
   if (n == 0) fail(path, kSuspension, "layout has no particles");
   if (layout.dimension != 2 && layout.dimension != 3)
     fail(path, susp("box"), fmt::format("dimension {} is neither 2 nor 3", layout.dimension));
-  if (layout.dimension == 3 && layout.write_contacts)
-    fail(path, kContacts, "the contact network of spheres is not written (its forces are vectors)");
   if (layout.species.size() != n || layout.diameter.size() != n || layout.motion.size() != n) {
     fail(path, kSuspension,
          fmt::format("layout arrays sizes species={} diameter={} motion={} != n_particles={}",
@@ -821,8 +819,11 @@ void H5mdWriter::Impl::create_contacts() {
   const std::int8_t no_flag = -1;
   pairs = create_series(f, c + "/value", H5T_STD_I32LE, {0, 2}, 1, path, &no_pair);
   normal_force = create_series(f, c + "/normal_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+  // Discs: the force along t = z x n, one value per contact; spheres: the vector, three.
   tangential_force =
-      create_series(f, c + "/tangential_force", H5T_IEEE_F64LE, {0}, 1, path, &no_force);
+      create_series(f, c + "/tangential_force", H5T_IEEE_F64LE,
+                    layout.dimension == 3 ? std::vector<hsize_t>{0, 3} : std::vector<hsize_t>{0}, 1,
+                    path, &no_force);
   sliding = create_series(f, c + "/sliding", H5T_STD_I8LE, {0}, 1, path, &no_flag);
   write_unit(pairs->ds.get(), pairs->name, kNumber, path);
   write_unit(normal_force->ds.get(), normal_force->name, kForce, path);
@@ -895,7 +896,9 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
     const std::string c = kContacts;
     m->pairs = value(c + "/value", {0, 2}, true);
     m->normal_force = value(c + "/normal_force", {0}, true);
-    m->tangential_force = value(c + "/tangential_force", {0}, true);
+    m->tangential_force =
+        value(c + "/tangential_force",
+              dim == 3 ? std::vector<hsize_t>{0, 3} : std::vector<hsize_t>{0}, true);
     m->sliding = value(c + "/sliding", {0}, true);
   }
   m->frames = keep_frames;
@@ -952,7 +955,13 @@ void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_images,
     const ContactNetwork* c = frame.contacts;
     if (c == nullptr) fail(path, kContacts, "frame without its contact network");
     const std::size_t k = c->pairs.size();
-    if (c->normal_force.size() != k || c->tangential_force.size() != k || c->sliding.size() != k)
+    if (c->components != (spheres ? 3 : 1))
+      fail(path, kContacts,
+           fmt::format("{} tangential force components per contact in a {}D file", c->components,
+                       layout.dimension));
+    const std::size_t width = spheres ? 3 : 1;
+    if (c->normal_force.size() != k || c->tangential_force.size() != width * k ||
+        c->sliding.size() != k)
       fail(path, kContacts, "contact arrays of different lengths");
     for (const auto& pr : c->pairs)
       for (int i : pr)
@@ -1294,15 +1303,24 @@ ContactNetwork read_h5md_contacts(const fs::path& file, long frame) {
   const auto ij = r.read_rows<std::int32_t>(base + "/value", H5T_NATIVE_INT32, idx, 1, &inner);
   if (inner.size() != 2 || inner[1] != 2) fail(file, base + "/value", "expected (frames, M, 2)");
   const auto fn = r.read_rows<double>(base + "/normal_force", H5T_NATIVE_DOUBLE, idx, 1);
-  const auto ft = r.read_rows<double>(base + "/tangential_force", H5T_NATIVE_DOUBLE, idx, 1);
+  std::vector<hsize_t> ft_inner;
+  const auto ft =
+      r.read_rows<double>(base + "/tangential_force", H5T_NATIVE_DOUBLE, idx, 1, &ft_inner);
+  // (frames, M) for discs, (frames, M, 3) for spheres.
+  if (ft_inner.size() == 2 && ft_inner[1] == 3)
+    c.components = 3;
+  else if (ft_inner.size() != 1)
+    fail(file, base + "/tangential_force", "expected (frames, M) or (frames, M, 3)");
   const auto sl = r.read_rows<std::int8_t>(base + "/sliding", H5T_NATIVE_INT8, idx, 1);
-  if (fn.size() != inner[0] || ft.size() != inner[0] || sl.size() != inner[0])
+  const auto width = static_cast<std::size_t>(c.components);
+  if (fn.size() != inner[0] || ft.size() != width * inner[0] || sl.size() != inner[0])
     fail(file, base, "per-contact datasets of different widths");
   for (std::size_t q = 0; q < inner[0]; ++q) {
     if (ij[2 * q] < 0 || ij[2 * q + 1] < 0) continue;  // the fill value: no contact
     c.pairs.push_back({ij[2 * q], ij[2 * q + 1]});
     c.normal_force.push_back(fn[q]);
-    c.tangential_force.push_back(ft[q]);
+    c.tangential_force.insert(c.tangential_force.end(), ft.begin() + width * q,
+                              ft.begin() + width * (q + 1));
     c.sliding.push_back(sl[q]);
   }
   return c;

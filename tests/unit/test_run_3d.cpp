@@ -17,6 +17,7 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/engine.hpp"
 #include "sheardiff/integrator/stress.hpp"
+#include "sheardiff/io/h5md.hpp"
 #include "sheardiff/io/summary_keys.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/run.hpp"
@@ -108,6 +109,56 @@ void expect_trajectory_of_spheres(const fs::path& file, const nlohmann::json& js
   EXPECT_LT(largest_jump, 0.25 * last[0]);
 }
 
+// The contact network of the last frame against that frame's positions: every listed pair
+// overlaps; the tangential spring force on j is a vector in the plane normal to n (to round-off:
+// the spring was turned into that plane at these positions) within Coulomb's cone, and on it for
+// the sliding contacts (a tangential force of the wrong stiffness scale would leave the cone's
+// surface).
+void expect_contacts_of_spheres(const fs::path& file, double mu) {
+  const ContactNetwork c = read_h5md_contacts(file, -1);
+  ASSERT_EQ(c.components, 3);
+  ASSERT_GT(c.pairs.size(), 20u);
+  ASSERT_EQ(c.tangential_force.size(), 3 * c.pairs.size());
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const std::string g = "/particles/suspension/";
+  const std::vector<hsize_t> pos = shape(f, g + "position/value");
+  const hsize_t frames = pos[0], n = pos[1];
+  std::vector<double> edges(9 * frames), position(3 * n * frames), diameter(n);
+  for (const auto& [name, out] : {std::pair<std::string, double*>{"box/edges/value", edges.data()},
+                                  {"position/value", position.data()},
+                                  {"diameter", diameter.data()}}) {
+    const hid_t ds = H5Dopen2(f, (g + name).c_str(), H5P_DEFAULT);
+    H5Dread(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out);
+    H5Dclose(ds);
+  }
+  H5Fclose(f);
+  const double lx = edges[9 * (frames - 1)], lz = edges[9 * (frames - 1) + 8];
+  const double* x = &position[3 * n * (frames - 1)];
+  int sliding = 0, loaded = 0;
+  for (std::size_t k = 0; k < c.pairs.size(); ++k) {
+    const auto [i, j] = c.pairs[k];
+    Space3 d(x[3 * j] - x[3 * i], x[3 * j + 1] - x[3 * i + 1], x[3 * j + 2] - x[3 * i + 2]);
+    d.x() -= lx * std::round(d.x() / lx);  // periodic in x and z, walls in y
+    d.z() -= lz * std::round(d.z() / lz);
+    const double overlap = 0.5 * (diameter[i] + diameter[j]) - d.norm();
+    EXPECT_GT(overlap, 0.0) << "contact " << k;
+    const double fn = c.normal_force[k];
+    const Space3 ft(c.tangential_force[3 * k], c.tangential_force[3 * k + 1],
+                    c.tangential_force[3 * k + 2]);
+    EXPECT_GT(fn, 0.0) << "contact " << k;
+    EXPECT_LE(std::abs(ft.dot(d.normalized())), 1e-9 * (fn + ft.norm())) << "contact " << k;
+    EXPECT_LE(ft.norm(), mu * fn * (1.0 + 1e-9)) << "contact " << k;
+    if (c.sliding[k] != 0) {
+      ++sliding;
+      EXPECT_NEAR(ft.norm(), mu * fn, 1e-9 * fn) << "sliding contact " << k;
+    }
+    loaded += ft.norm() > 1e-3 * fn;
+  }
+  EXPECT_GT(sliding, 0) << "no sliding contact: the Coulomb check had nothing to test";
+  EXPECT_GT(loaded, static_cast<int>(c.pairs.size()) / 4) << "the tangential springs carry load";
+}
+
 TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
   const std::string base = "[scene]\ntype = \"pressure_shear\"\ndimension = 3\n";
   const Config c = parse_config(base, "t.toml");
@@ -122,7 +173,6 @@ TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
       EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   };
-  refused(base + "[output]\ncontacts = true\n", "output.contacts");
   refused("[scene]\ntype = \"channel\"\ndimension = 3\n", "scene.dimension");
   refused("[scene]\ntype = \"simple_shear\"\ndimension = 3\n[particles]\nphi_init_spheres = 0\n",
           "particles.phi_init_spheres");
@@ -136,7 +186,9 @@ TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
 TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {
   const fs::path dir = fs::temp_directory_path() / "sheardiff_test_sphere_run";
   fs::remove_all(dir);
-  const nlohmann::json js = run_to_directory(sphere_cell(1.5), dir, false);
+  Config cfg = sphere_cell(1.5);
+  cfg.output.contacts = true;
+  const nlohmann::json js = run_to_directory(cfg, dir, false);
   EXPECT_EQ(js[summary_key::dimension].get<int>(), 3);
   EXPECT_EQ(js[summary_key::N].get<int>(), 64);
   // Wall force = P Lx Lz at every step the packing holds the wall (the solve's balance, 1e-9).
@@ -152,6 +204,7 @@ TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {
   EXPECT_LT(js[summary_key::mean_overlap].get<double>(), 5e-3);
   EXPECT_TRUE(std::isfinite(js[summary_key::shear_stress].get<double>()));
   expect_trajectory_of_spheres(dir / "trajectory.h5", js);
+  expect_contacts_of_spheres(dir / "trajectory.h5", cfg.contact.mu);
   // `analyse` recomputes runs of discs: a run of spheres is refused, naming why.
   try {
     reanalyse_run(dir);

@@ -65,5 +65,6 @@ StressSample average(const StressSample& a, const StressSample& b);
 
 // The contacts open at the current configuration with their spring forces (ContactNetwork).
 ContactNetwork contact_network(const Dynamics& d);
+ContactNetwork contact_network(const Dynamics3& d);
 
 }  // namespace sheardiff

@@ -24,7 +24,7 @@ struct TrajectoryLayout {
   int dimension = 2;                     // 2: discs; 3: spheres, periodic in z
   bool lees_edwards = false;             // y boundary: "periodic" if true, else "none"
   bool write_velocity = true;            // write velocity and angular_velocity (omega_z or omega)
-  bool write_contacts = false;           // write /connectivity/contacts every frame (discs)
+  bool write_contacts = false;           // write /connectivity/contacts every frame
   std::vector<std::string> observables;  // names of scalar observables written per frame
   // H5MD unit strings in the project's units (docs/trajectory.md), same order as observables;
   // empty: every observable is dimensionless ("1").
