@@ -129,6 +129,8 @@ void write_trajectory_frame(H5mdWriter& writer, const Config& cfg, const Running
     f.lz = d.box().lz;
     f.position3 = &p.position;
     if (images) f.image3 = &p.image;
+    // As for discs: under Lees-Edwards the unwrapped x is not position + image . edges.
+    if (d.box().lees_edwards && images) f.unwrapped3 = &p.unwrapped;
     f.velocity6 = &run.sim.integrator().velocities().u;
     if (cfg.output.contacts) contacts = contact_network(d);
     f.contacts = &contacts;

@@ -146,16 +146,15 @@ class Store:
 
 
 def unwrapped_positions(group, frames=slice(None)):
-    """The unwrapped positions (frames x N x 2) of an H5MD particle group: stored under
-    Lees-Edwards, else position + image . edges (the pressure cell and the channel store no copy)."""
-    import numpy as np
-
+    """The unwrapped positions (frames x N x 2, or x 3 for spheres) of an H5MD particle group:
+    stored under Lees-Edwards, else position + image . edges (the pressure cell and the channel
+    store no copy)."""
     if "unwrapped_position" in group:
         return group["unwrapped_position/value"][frames]
     pos = group["position/value"][frames]
     img = group["image/value"][frames].astype(float)
     edges = group["box/edges/value"][frames]
-    return pos + img[..., :1] * edges[:, None, 0, :] + img[..., 1:] * edges[:, None, 1, :]
+    return pos + img @ edges  # the rows of edges are the box vectors
 
 
 def read_trajectory(path):

@@ -634,7 +634,7 @@ struct H5mdWriter::Impl {
     const auto dim = static_cast<hsize_t>(layout.dimension);
     image = element(susp("image"), H5T_STD_I32LE, {n, dim}, 1, kNumber);
     if (with_unwrapped)
-      unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, 2}, 1, kLength);
+      unwrapped = element(susp("unwrapped_position"), H5T_IEEE_F64LE, {n, dim}, 1, kLength);
   }
 };
 
@@ -889,7 +889,7 @@ H5mdWriter H5mdWriter::resume(const fs::path& path, const TrajectoryLayout& layo
   if (H5Lexists(f, susp("image").c_str(), H5P_DEFAULT) > 0)
     m->image = value(susp("image/value"), {n, dim});
   if (H5Lexists(f, susp("unwrapped_position").c_str(), H5P_DEFAULT) > 0)
-    m->unwrapped = value(susp("unwrapped_position/value"), {n, 2});
+    m->unwrapped = value(susp("unwrapped_position/value"), {n, dim});
   for (const auto& name : layout.observables)
     m->observables.push_back(value("/observables/" + name + "/value", {}));
   if (layout.write_contacts) {
@@ -940,11 +940,12 @@ void H5mdWriter::Impl::check_frame(const FrameData& frame, bool want_images,
   if (spheres && !(frame.lz > 0.0))
     fail(path, susp("box/edges"), fmt::format("invalid box lz = {}", frame.lz));
   if (want_unwrapped) {
-    if (frame.unwrapped == nullptr) {
+    if (spheres ? frame.unwrapped3 == nullptr : frame.unwrapped == nullptr) {
       fail(path, susp("unwrapped_position"),
            "unwrapped positions were written at frame 0 but are missing now");
     }
-    check_size(frame.unwrapped->size(), susp("unwrapped_position"));
+    check_size(spheres ? frame.unwrapped3->size() : frame.unwrapped->size(),
+               susp("unwrapped_position"));
   }
   if (frame.observables.size() != layout.observables.size()) {
     fail(path, "/observables",
@@ -1017,6 +1018,12 @@ void H5mdWriter::Impl::append_sphere_images(const FrameData& frame) {
     img[3 * i + 2] = static_cast<std::int32_t>(iz);
   }
   image->append(H5T_NATIVE_INT32, img.data(), path);
+  if (!unwrapped) return;
+  std::vector<double> buf(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      buf[3 * i + static_cast<std::size_t>(c)] = (*frame.unwrapped3)[i](c);
+  unwrapped->append(H5T_NATIVE_DOUBLE, buf.data(), path);
 }
 
 void H5mdWriter::Impl::append_velocity(const FrameData& frame) {
@@ -1067,7 +1074,9 @@ void H5mdWriter::write_frame(const FrameData& frame) {
   const bool want_images = m.frames == 0 ? frame.image != nullptr || frame.unwrapped != nullptr ||
                                                frame.image3 != nullptr
                                          : m.image.has_value();
-  const bool want_unwrapped = m.frames == 0 ? frame.unwrapped != nullptr : m.unwrapped.has_value();
+  const bool want_unwrapped = m.frames == 0
+                                  ? frame.unwrapped != nullptr || frame.unwrapped3 != nullptr
+                                  : m.unwrapped.has_value();
   m.check_frame(frame, want_images, want_unwrapped);
   if (m.frames == 0 && want_images) m.create_images(want_unwrapped);
 
@@ -1235,8 +1244,11 @@ void read_velocities(const Reader& r, const std::string& g, hsize_t idx, hsize_t
   if (has_omega) {
     std::vector<hsize_t> inner;
     const auto w = r.read_rows<double>(omega_name, H5T_NATIVE_DOUBLE, idx, 1, &inner);
-    expect_shape(r, omega_name, inner, {n});
-    for (std::size_t i = 0; i < n; ++i) out.velocity[i].z() = w[i];
+    // Discs: omega (a scalar about z); spheres: the vector, of which z is kept.
+    const std::size_t width = out.dimension == 3 ? 3 : 1;
+    expect_shape(r, omega_name, inner,
+                 width == 3 ? std::vector<hsize_t>{n, 3} : std::vector<hsize_t>{n});
+    for (std::size_t i = 0; i < n; ++i) out.velocity[i].z() = w[width * i + width - 1];
   }
 }
 
@@ -1270,6 +1282,7 @@ H5mdFrame read_h5md_frame(const fs::path& file, long frame) {
   H5mdFrame out;
   out.position = read_vectors(r, g + "/position/value", idx, std::nullopt);
   const hsize_t n = out.position.size();
+  out.dimension = static_cast<int>(r.dims(g + "/position/value").back());
   out.step =
       static_cast<long>(axis_value<std::int64_t>(r, g + "/position/step", H5T_NATIVE_INT64, idx));
   if (r.exists(g + "/position/time"))

@@ -287,11 +287,6 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
         "{}: a channel run has no diffusion analysis to recompute; its results are channel.h5 "
         "and summary.json, read by tools/channel_table.py",
         dir.string()));
-  if (cfg.scene.dimension == 3)
-    throw ConfigError(fmt::format(
-        "{}: a run of spheres (scene.dimension = 3) is analysed while it runs (summary.json, "
-        "analysis.h5); `analyse` recomputes runs of discs only",
-        dir.string()));
   // The measured window: frames from the detection of steady state (pressure cell) or after
   // the transient (simple shear), the same test the observers applied while running.
   const bool pressure = scene_kind(cfg.scene.type).measured_from_steady_state();
@@ -309,7 +304,9 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
         fmt::format("{}: only {} frames in the measured window", dir.string(), frames.size()));
   // The run measured its profiles at every step; frames can only approximate them, so they are
   // computed here only for a run that has none (an older version's).
-  const bool want_profiles = pressure && !run.contains(summary_key::profile_phi);
+  // (A run of spheres always measured its own; the frames' profiles are of discs.)
+  const bool want_profiles =
+      pressure && cfg.scene.dimension == 2 && !run.contains(summary_key::profile_phi);
   WindowFrames w = read_window(traj, frames, cfg, want_profiles);
   Eigen::MatrixXd mask;
   if (w.walls) mask = bulk_mask(w.y, w.bottom, w.top, cfg.observables.wall_exclusion);

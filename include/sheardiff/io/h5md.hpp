@@ -48,11 +48,12 @@ struct FrameData {
   const std::vector<Vec3>* velocity = nullptr;  // (u_x,u_y,omega), required if write_velocity
   const ContactNetwork* contacts = nullptr;     // required if write_contacts
   std::vector<double> observables;              // same order as layout.observables
-  // Spheres (layout.dimension = 3), in place of position, image and velocity (unwrapped
-  // positions are not taken: position + image . edges is the unwrapped one without
-  // Lees-Edwards, and image counts are required with it).
+  // Spheres (layout.dimension = 3), in place of position, unwrapped, image and velocity (image
+  // counts are required with the unwrapped positions, which are wanted as for discs only under
+  // Lees-Edwards: without it position + image . edges is the unwrapped one).
   double lz = 1;  // the periodic depth
   const std::vector<Space3>* position3 = nullptr;
+  const std::vector<Space3>* unwrapped3 = nullptr;  // optional; only honoured if given at frame 0
   const std::vector<std::array<int, 3>>* image3 = nullptr;
   const std::vector<Vec6>* velocity6 = nullptr;  // (u, omega)
 };
@@ -90,15 +91,19 @@ class H5mdWriter {
 
 // One frame of an H5MD particle group: ours, or any writer's with a 2D box (or a 3D one,
 // of which x and y are taken). Read from the group "suspension", else "all", else the only one.
+// One frame, in the x-y plane: a frame of spheres (dimension 3) keeps x and y of every vector
+// and omega_z as the velocity's third entry (what the shear-plane analyses read).
 struct H5mdFrame {
   long step = 0;
   double time = 0;
   double lx = 0, ly = 0;
   double tilt = 0;         // x component of the second edge vector (0 for a cuboid box)
   bool periodic_y = true;  // box/boundary[1]; ly is a placeholder where it is "none"
+  int dimension = 2;       // of the positions in the file
   std::vector<Vec2> position;
-  std::vector<Vec2> unwrapped;  // empty if the file has no unwrapped_position
-  std::vector<Vec3> velocity;   // empty if the file has no velocity
+  // Empty if the file has no unwrapped_position and (without Lees-Edwards) no image.
+  std::vector<Vec2> unwrapped;
+  std::vector<Vec3> velocity;  // (v_x, v_y, omega_z); empty if the file has no velocity
   std::vector<double> diameter;
   std::vector<int> species;
   std::vector<int> motion;
