@@ -105,46 +105,44 @@ template double normal_load_between(const Dynamics&, const Velocities&, double, 
 template double normal_load_between(const Dynamics3&, const VelocitiesOf<Dim3>&, double, double,
                                     double);
 
-ContactNetwork contact_network(const Dynamics& d) {
+namespace {
+
+template <class D>
+ContactNetwork contact_network_of(const DynamicsOf<D>& d) {
   ContactNetwork c;
-  const Particles& p = d.particles();
+  c.components = D::space == 2 ? 1 : 3;
+  const auto& p = d.particles();
   const FrictionalContact& law = d.force_balance().contact();
-  for (const Pair& pr : d.neighbours().pairs()) {
+  for (const auto& pr : d.neighbours().pairs()) {
     if (!pr.history.touching) continue;
     // Geometry of now, not of the last solve: the frame shows the positions of now.
-    const PairGeometry g =
-        PairGeometry::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
+    const auto g =
+        PairGeometryOf<D>::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
     // A pair the last move opened is touching until the next contact update, but not in contact
     // at these positions: listed, it showed a normal force of exactly 0.
     if (!(g.overlap() > 0.0)) continue;
     c.pairs.push_back({pr.i, pr.j});
     c.normal_force.push_back(law.kn_of(g) * g.overlap());
-    c.tangential_force.push_back(-law.kt_of(g) *
-                                 pr.history.contact.xi);  // spring force on j along z x n
+    // The spring force on j, -kt xi: along z x n for discs; for spheres the vector in the plane
+    // normal to n as the last cap left it (FrictionalContact::spring_force_3d).
+    if constexpr (D::space == 2) {
+      c.tangential_force.push_back(-law.kt_of(g) * pr.history.contact.xi);
+    } else {
+      const Space3 ft = -law.kt_of(g) * pr.history.contact.xi;
+      c.tangential_force.insert(c.tangential_force.end(), {ft.x(), ft.y(), ft.z()});
+    }
     c.sliding.push_back(pr.history.contact.sliding ? 1 : 0);
   }
   return c;
 }
 
+}  // namespace
+
+ContactNetwork contact_network(const Dynamics& d) {
+  return contact_network_of(d);
+}
 ContactNetwork contact_network(const Dynamics3& d) {
-  ContactNetwork c;
-  c.components = 3;
-  const Particles3& p = d.particles();
-  const FrictionalContact& law = d.force_balance().contact();
-  for (const Pair3& pr : d.neighbours().pairs()) {
-    if (!pr.history.touching) continue;
-    const PairGeometry3 g =
-        PairGeometry3::make(pair_separation(p, d.box(), pr), p.radius[pr.i], p.radius[pr.j]);
-    if (!(g.overlap() > 0.0)) continue;
-    c.pairs.push_back({pr.i, pr.j});
-    c.normal_force.push_back(law.kn_of(g) * g.overlap());
-    // The spring on j is -kt xi (FrictionalContact::spring_force_3d), xi in the plane normal to
-    // n as the last cap left it.
-    const Space3 ft = -law.kt_of(g) * pr.history.contact.xi;
-    c.tangential_force.insert(c.tangential_force.end(), {ft.x(), ft.y(), ft.z()});
-    c.sliding.push_back(pr.history.contact.sliding ? 1 : 0);
-  }
-  return c;
+  return contact_network_of(d);
 }
 
 }  // namespace sheardiff
