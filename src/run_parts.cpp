@@ -233,7 +233,7 @@ void CheckpointStoreOf<D>::load(RunningStateOf<D>& run, CheckpointPayload payloa
             "sheardiff that started it (its version and git hash are at the top of "
             "{}/run.log), or start it again with --overwrite",
             file_.string(), payload.layout, out_));
-  Archive a = Archive::reader(std::move(payload.bytes));
+  Archive a = Archive::reader(std::move(payload.bytes), payload.layout);
   try {
     serialize(a, run, payload.layout);
   } catch (const ConfigError&) {

@@ -21,26 +21,20 @@ DriftSignal judged(const std::string& name, double value, double err, double lim
 
 }  // namespace
 
-DriftSignal mean_within_noise(const std::string& name, const std::vector<double>& t,
-                              const std::vector<double>& x, double expected, double from, double to,
-                              long blocks, double z) {
-  const BatchMeans b = batch_means(t, x, from, to, blocks);
+DriftSignal mean_within_noise(const std::string& name, const BatchMeans& b, double expected,
+                              double z) {
   return judged(name, b.mean - expected, b.err, z * b.err, expected);
 }
 
-DriftSignal mean_within_tolerance(const std::string& name, const std::vector<double>& t,
-                                  const std::vector<double>& x, double expected, double from,
-                                  double to, long blocks, double tolerance) {
-  const BatchMeans b = batch_means(t, x, from, to, blocks);
+DriftSignal mean_within_tolerance(const std::string& name, const BatchMeans& b, double expected,
+                                  double tolerance) {
   DriftSignal s = judged(name, b.mean - expected, b.err, tolerance, expected);
   s.ok = std::isfinite(b.mean) && std::abs(b.mean - expected) <= tolerance;
   return s;
 }
 
-DriftSignal trend_within_noise(const std::string& name, const std::vector<double>& t,
-                               const std::vector<double>& x, double from, double to, long blocks,
-                               double z) {
-  const BatchMeans b = batch_means(t, x, from, to, blocks);
+DriftSignal trend_within_noise(const std::string& name, const BatchMeans& b, double from, double to,
+                               long blocks, double z) {
   if (b.blocks != blocks || blocks < 4) return judged(name, kNaN, kNaN, kNaN);
   // Block midpoints; the fit's slope error uses the block means' own scatter about the line.
   std::vector<double> mid(static_cast<std::size_t>(blocks));
@@ -50,6 +44,24 @@ DriftSignal trend_within_noise(const std::string& name, const std::vector<double
   const LineFit f = fit_line(mid, b.block_means);
   const double span = to - from;
   return judged(name, f.slope * span, f.slope_stderr * span, z * f.slope_stderr * span);
+}
+
+DriftSignal mean_within_noise(const std::string& name, const std::vector<double>& t,
+                              const std::vector<double>& x, double expected, double from, double to,
+                              long blocks, double z) {
+  return mean_within_noise(name, batch_means(t, x, from, to, blocks), expected, z);
+}
+
+DriftSignal mean_within_tolerance(const std::string& name, const std::vector<double>& t,
+                                  const std::vector<double>& x, double expected, double from,
+                                  double to, long blocks, double tolerance) {
+  return mean_within_tolerance(name, batch_means(t, x, from, to, blocks), expected, tolerance);
+}
+
+DriftSignal trend_within_noise(const std::string& name, const std::vector<double>& t,
+                               const std::vector<double>& x, double from, double to, long blocks,
+                               double z) {
+  return trend_within_noise(name, batch_means(t, x, from, to, blocks), from, to, blocks, z);
 }
 
 bool StationarityVerdict::stationary() const {

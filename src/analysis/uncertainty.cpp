@@ -12,7 +12,114 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Sums of samples by block of [t_from, t_to], and the batch means they give. A bin of samples
+// enters whole, at its time, with its sum and count; a lone sample is a bin of one.
+class BlockSums {
+ public:
+  BlockSums(double t_from, double t_to, long blocks) : from_(t_from), to_(t_to), blocks_(blocks) {
+    if (blocks < 1 || !(t_to > t_from))
+      throw std::invalid_argument(
+          fmt::format("batch_means: need blocks >= 1 and t_to > t_from (got {}, [{}, {}])", blocks,
+                      t_from, t_to));
+    width_ = (t_to - t_from) / static_cast<double>(blocks);
+    sum_.assign(static_cast<std::size_t>(blocks), 0.0);
+    count_.assign(static_cast<std::size_t>(blocks), 0.0);
+  }
+  void add(double t, double sum, double count) {
+    if (t < from_ || t > to_) return;
+    const auto b =
+        static_cast<std::size_t>(std::min(blocks_ - 1, static_cast<long>((t - from_) / width_)));
+    sum_[b] += sum;
+    count_[b] += count;
+    total_ += sum;
+    n_ += count;
+  }
+  BatchMeans result() const {
+    BatchMeans out;
+    out.mean = n_ > 0 ? total_ / n_ : kNaN;
+    for (std::size_t b = 0; b < sum_.size(); ++b)
+      if (count_[b] > 0) out.block_means.push_back(sum_[b] / count_[b]);
+    out.blocks = static_cast<long>(out.block_means.size());
+    if (out.blocks < 2) {
+      out.err = kNaN;
+      return out;
+    }
+    double m = 0;
+    for (double v : out.block_means) m += v;
+    m /= static_cast<double>(out.blocks);
+    double s = 0;
+    for (double v : out.block_means) s += (v - m) * (v - m);
+    out.err = std::sqrt(s / static_cast<double>(out.blocks - 1) / static_cast<double>(out.blocks));
+    return out;
+  }
+
+ private:
+  double from_, to_, width_ = 0;
+  long blocks_;
+  std::vector<double> sum_, count_;
+  double total_ = 0, n_ = 0;
+};
+
 }  // namespace
+
+BinnedSeries::BinnedSeries(std::size_t signals, std::size_t max_bins)
+    : signals_(signals), max_bins_(max_bins) {
+  if (max_bins < 2 || max_bins % 2 != 0)
+    throw std::invalid_argument(
+        fmt::format("BinnedSeries: max_bins {} is not even and >= 2", max_bins));
+}
+
+void BinnedSeries::add(double t, const std::vector<double>& x) {
+  if (x.size() != signals_)
+    throw std::invalid_argument(
+        fmt::format("BinnedSeries: {} values for {} signals", x.size(), signals_));
+  if (n_.empty() || n_.back() >= static_cast<double>(per_bin_)) {
+    if (n_.size() == max_bins_) {
+      // Full: join neighbours, so that the bins (each now twice as long) fill again by halves.
+      const std::size_t half = max_bins_ / 2;
+      for (std::size_t k = 0; k < half; ++k) {
+        n_[k] = n_[2 * k] + n_[2 * k + 1];
+        t_sum_[k] = t_sum_[2 * k] + t_sum_[2 * k + 1];
+        for (std::size_t s = 0; s < signals_; ++s) {
+          sum_[k * signals_ + s] = sum_[2 * k * signals_ + s] + sum_[(2 * k + 1) * signals_ + s];
+          count_[k * signals_ + s] =
+              count_[2 * k * signals_ + s] + count_[(2 * k + 1) * signals_ + s];
+        }
+      }
+      n_.resize(half), t_sum_.resize(half);
+      sum_.resize(half * signals_), count_.resize(half * signals_);
+      per_bin_ *= 2;
+    }
+    n_.push_back(0.0), t_sum_.push_back(0.0);
+    sum_.resize(sum_.size() + signals_, 0.0), count_.resize(count_.size() + signals_, 0.0);
+  }
+  const std::size_t k = n_.size() - 1;
+  n_[k] += 1.0;
+  t_sum_[k] += t;
+  for (std::size_t s = 0; s < signals_; ++s)
+    if (std::isfinite(x[s])) sum_[k * signals_ + s] += x[s], count_[k * signals_ + s] += 1.0;
+  ++samples_;
+  last_t_ = t;
+}
+
+void BinnedSeries::serialize(Archive& a) {
+  std::uint64_t signals = signals_, max_bins = max_bins_;
+  a.io(signals), a.io(max_bins);
+  signals_ = signals, max_bins_ = max_bins;
+  a.io(per_bin_), a.io(samples_), a.io(last_t_);
+  a.io(n_), a.io(t_sum_), a.io(sum_), a.io(count_);
+  if (a.loading() && (t_sum_.size() != n_.size() || sum_.size() != n_.size() * signals_ ||
+                      count_.size() != sum_.size() || n_.size() > max_bins_))
+    throw std::runtime_error("checkpoint: a binned series whose sizes do not match");
+}
+
+BatchMeans batch_means(const BinnedSeries& x, std::size_t s, double t_from, double t_to,
+                       long blocks) {
+  BlockSums b(t_from, t_to, blocks);
+  for (std::size_t k = 0; k < x.bins(); ++k)
+    if (x.count(k, s) > 0.0) b.add(x.time(k), x.sum(k, s), x.count(k, s));
+  return b.result();
+}
 
 double jackknife_err(const std::vector<double>& x) {
   const auto n = static_cast<double>(x.size());
@@ -32,41 +139,10 @@ BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& 
   if (t.size() != x.size())
     throw std::invalid_argument(
         fmt::format("batch_means: {} times but {} samples", t.size(), x.size()));
-  if (blocks < 1 || !(t_to > t_from))
-    throw std::invalid_argument(
-        fmt::format("batch_means: need blocks >= 1 and t_to > t_from (got {}, [{}, {}])", blocks,
-                    t_from, t_to));
-  BatchMeans out;
-  std::vector<double> sum(static_cast<std::size_t>(blocks), 0.0);
-  std::vector<long> count(static_cast<std::size_t>(blocks), 0);
-  const double width = (t_to - t_from) / static_cast<double>(blocks);
-  double total = 0;
-  long n = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < t_from || t[k] > t_to || !std::isfinite(x[k])) continue;
-    const auto b = std::min(blocks - 1, static_cast<long>((t[k] - t_from) / width));
-    sum[static_cast<std::size_t>(b)] += x[k];
-    ++count[static_cast<std::size_t>(b)];
-    total += x[k];
-    ++n;
-  }
-  out.mean = n > 0 ? total / static_cast<double>(n) : kNaN;
-  for (long b = 0; b < blocks; ++b)
-    if (count[static_cast<std::size_t>(b)] > 0)
-      out.block_means.push_back(sum[static_cast<std::size_t>(b)] /
-                                static_cast<double>(count[static_cast<std::size_t>(b)]));
-  out.blocks = static_cast<long>(out.block_means.size());
-  if (out.blocks < 2) {
-    out.err = kNaN;
-    return out;
-  }
-  double m = 0;
-  for (double v : out.block_means) m += v;
-  m /= static_cast<double>(out.blocks);
-  double s = 0;
-  for (double v : out.block_means) s += (v - m) * (v - m);
-  out.err = std::sqrt(s / static_cast<double>(out.blocks - 1) / static_cast<double>(out.blocks));
-  return out;
+  BlockSums b(t_from, t_to, blocks);
+  for (std::size_t k = 0; k < t.size(); ++k)
+    if (std::isfinite(x[k])) b.add(t[k], x[k], 1.0);
+  return b.result();
 }
 
 namespace {

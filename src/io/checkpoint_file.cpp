@@ -14,14 +14,16 @@ namespace sheardiff {
 
 namespace {
 
-// The digit is the state layout (CheckpointPayload::layout); 3 to 6 share the header.
-constexpr char kMagic[] = "sheardiff-checkpoint-6";
+// The digit is the state layout (CheckpointPayload::layout); 3 to 7 share the header.
+constexpr char kMagic[] = "sheardiff-checkpoint-7";
+constexpr char kLayout6Magic[] = "sheardiff-checkpoint-6";
 constexpr char kLayout5Magic[] = "sheardiff-checkpoint-5";
 constexpr char kLayout4Magic[] = "sheardiff-checkpoint-4";
 constexpr char kLayout3Magic[] = "sheardiff-checkpoint-3";
 constexpr char kLegacyMagic[] = "sheardiff-checkpoint-2";
 constexpr std::uint64_t kMagicLength = sizeof(kMagic) - 1;
-static_assert(sizeof(kLegacyMagic) == sizeof(kMagic) && sizeof(kLayout3Magic) == sizeof(kMagic));
+static_assert(sizeof(kLegacyMagic) == sizeof(kMagic) && sizeof(kLayout3Magic) == sizeof(kMagic) &&
+              sizeof(kLayout6Magic) == sizeof(kMagic));
 constexpr std::size_t kHeader = 8 + kMagicLength + 8 + 4;
 
 template <class T>
@@ -96,6 +98,8 @@ CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
     out.layout = 4;
   else if (starts_with_magic(b, kLayout5Magic))
     out.layout = 5;
+  else if (starts_with_magic(b, kLayout6Magic))
+    out.layout = 6;
   else if (!starts_with_magic(b, kMagic))
     throw corrupt(
         fmt::format("it does not begin with the magic \"{}\" ({} bytes)", kMagic, b.size()));

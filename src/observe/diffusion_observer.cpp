@@ -236,14 +236,16 @@ void add_window_keys(const std::filesystem::path& traj, const Config& cfg,
                      const std::vector<double>& strain, double from, double last,
                      nlohmann::json& computed) {
   const auto series = [&](const char* name) { return read_h5md_observable(traj, name).value; };
-  const auto h = series("H"), mu_top = series("mu_top"), mu_bottom = series("mu_bottom");
-  add_steady_errors(computed, strain, h, series("phi"), mu_top, mu_bottom, from, last,
-                    cfg.analysis.error_block);
-  if (has_h5md_observable(traj, "net_drag_y"))
-    add_stationarity(
-        computed, pressure_cell_stationarity(cfg.steady, strain, h, mu_top, mu_bottom,
-                                             series("net_drag_y"), series("bulk_normal_load"), from,
-                                             last, cfg.analysis.error_block));
+  // A run of an older sheardiff wrote no stationarity signals: its window has no verdict.
+  const bool signals = has_h5md_observable(traj, "net_drag_y");
+  const BinnedSeries window =
+      cell_window(strain, series("H"), series("phi"), series("mu_top"), series("mu_bottom"),
+                  signals ? series("net_drag_y") : std::vector<double>{},
+                  signals ? series("bulk_normal_load") : std::vector<double>{}, from, last);
+  add_steady_errors(computed, window, from, last, cfg.analysis.error_block);
+  if (signals)
+    add_stationarity(computed, pressure_cell_stationarity(cfg.steady, window, from, last,
+                                                          cfg.analysis.error_block));
 }
 
 // Writes what analyse found: nothing of the run's is replaced. Where the analysis disagrees

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/analysis/uncertainty.hpp"
@@ -15,21 +17,41 @@ namespace sheardiff {
 
 namespace {
 
-// Frames in [from, to]: the run passes the window's frames only, analyse the whole trajectory.
-long frames_between(const std::vector<double>& strain, double from, double to) {
-  return std::count_if(strain.begin(), strain.end(),
-                       [&](double s) { return s >= from && s <= to; });
-}
-
 constexpr long kMinWindowFrames = 8;
 
 }  // namespace
 
-void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
-                       const std::vector<double>& h, const std::vector<double>& phi,
-                       const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
-                       double from, double to, double block) {
-  const long n = to > from ? frames_between(strain, from, to) : 0;
+void add_cell_sample(BinnedSeries& window, double strain, double h, double phi, double mu_top,
+                     double mu_bottom, double net_drag_y, double bulk_load) {
+  window.add(strain, {h, phi, mu_top, mu_bottom, 0.5 * (mu_top + mu_bottom), mu_top - mu_bottom,
+                      net_drag_y, bulk_load});
+}
+
+BinnedSeries cell_window(const std::vector<double>& strain, const std::vector<double>& h,
+                         const std::vector<double>& phi, const std::vector<double>& mu_top,
+                         const std::vector<double>& mu_bottom,
+                         const std::vector<double>& net_drag_y,
+                         const std::vector<double>& bulk_load, double from, double to) {
+  const std::size_t n = strain.size();
+  const auto fits = [&](const std::vector<double>& v) { return v.empty() || v.size() == n; };
+  if (h.size() != n || mu_top.size() != n || mu_bottom.size() != n || !fits(phi) ||
+      !fits(net_drag_y) || !fits(bulk_load))
+    throw std::invalid_argument("cell_window: the signals' lengths differ from the strains'");
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  const auto at = [](const std::vector<double>& v, std::size_t k) {
+    return v.empty() ? kNone : v[k];
+  };
+  BinnedSeries w(CellSignal::count, kCellWindowBins);
+  for (std::size_t k = 0; k < n; ++k)
+    if (strain[k] >= from && strain[k] <= to)
+      add_cell_sample(w, strain[k], h[k], at(phi, k), mu_top[k], mu_bottom[k], at(net_drag_y, k),
+                      at(bulk_load, k));
+  return w;
+}
+
+void add_steady_errors(nlohmann::json& js, const BinnedSeries& window, double from, double to,
+                       double block) {
+  const long n = to > from ? window.samples() : 0;
   if (n < kMinWindowFrames) {
     // Said rather than printed as "+- nan": too few frames to form blocks from.
     js[summary_key::steady_errors_note] = fmt::format(
@@ -39,37 +61,35 @@ void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
     return;
   }
   const long blocks = std::max(4L, static_cast<long>((to - from) / block));
-  std::vector<double> mu(mu_top.size());
-  for (std::size_t k = 0; k < mu.size(); ++k) mu[k] = 0.5 * (mu_top[k] + mu_bottom[k]);
-  const auto err = [&](const std::vector<double>& x) {
-    const double e = batch_means(strain, x, from, to, blocks).err;
+  const auto err = [&](std::size_t signal) {
+    const double e = batch_means(window, signal, from, to, blocks).err;
     return std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr);
   };
-  js[summary_key::H_err] = err(h);
-  js[summary_key::phi_err] = err(phi);
-  js[summary_key::mu_err] = err(mu);
-  js[summary_key::mu_top_err] = err(mu_top);
-  js[summary_key::mu_bottom_err] = err(mu_bottom);
+  js[summary_key::H_err] = err(CellSignal::h);
+  js[summary_key::phi_err] = err(CellSignal::phi);
+  js[summary_key::mu_err] = err(CellSignal::mu);
+  js[summary_key::mu_top_err] = err(CellSignal::mu_top);
+  js[summary_key::mu_bottom_err] = err(CellSignal::mu_bottom);
 }
 
-StationarityVerdict pressure_cell_stationarity(
-    const SteadyStateParams& cfg, const std::vector<double>& strain, const std::vector<double>& h,
-    const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
-    const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
-    double to, double block) {
+StationarityVerdict pressure_cell_stationarity(const SteadyStateParams& cfg,
+                                               const BinnedSeries& window, double from, double to,
+                                               double block) {
   StationarityVerdict v;
-  if (!(to > from) || frames_between(strain, from, to) < kMinWindowFrames) return v;
+  if (!(to > from) || window.samples() < kMinWindowFrames) return v;
   const long blocks = std::max(4L, static_cast<long>((to - from) / block));
-  std::vector<double> dmu(mu_top.size());
-  for (std::size_t k = 0; k < dmu.size(); ++k) dmu[k] = mu_top[k] - mu_bottom[k];
+  const auto means = [&](std::size_t signal) {
+    return batch_means(window, signal, from, to, blocks);
+  };
   const double z = cfg.drift_z;
   v.signals.push_back(
-      mean_within_noise(summary_key::net_drag_y, strain, net_drag_y, 0.0, from, to, blocks, z));
+      mean_within_noise(summary_key::net_drag_y, means(CellSignal::net_drag_y), 0.0, z));
+  v.signals.push_back(mean_within_noise(summary_key::mu_top_minus_bottom,
+                                        means(CellSignal::mu_difference), 0.0, z));
   v.signals.push_back(
-      mean_within_noise(summary_key::mu_top_minus_bottom, strain, dmu, 0.0, from, to, blocks, z));
-  v.signals.push_back(trend_within_noise(summary_key::H_change, strain, h, from, to, blocks, z));
-  v.signals.push_back(mean_within_tolerance(summary_key::bulk_normal_load, strain, bulk_load, 1.0,
-                                            from, to, blocks, cfg.bulk_load_tolerance));
+      trend_within_noise(summary_key::H_change, means(CellSignal::h), from, to, blocks, z));
+  v.signals.push_back(mean_within_tolerance(
+      summary_key::bulk_normal_load, means(CellSignal::bulk_load), 1.0, cfg.bulk_load_tolerance));
   return v;
 }
 
@@ -157,13 +177,7 @@ void PressureCellObserverOf<D>::on_frame(const StepView& v, std::vector<double>&
   // The measured window's frames: from the one at which steady state is detected on, the
   // frames the diffusion analysis and `sheardiff analyse` use.
   const auto sample = [&] {
-    s_strain_.push_back(d.strain());
-    s_h_.push_back(h);
-    s_phi_.push_back(phi);
-    s_mu_top_.push_back(mu_top);
-    s_mu_bottom_.push_back(mu_bottom);
-    s_drag_.push_back(drag);
-    s_load_.push_back(load);
+    add_cell_sample(window_, d.strain(), h, phi, mu_top, mu_bottom, drag, load);
   };
   if (steady()) return sample();
   // The packing at rest before the first step is not yet sheared: no sample for the test.
@@ -175,6 +189,14 @@ void PressureCellObserverOf<D>::on_frame(const StepView& v, std::vector<double>&
   if (now - hist_strain_.front() < steady_cfg_.window) return;
   // Means of H and mu over the two halves of the last window.
   const double start = now - steady_cfg_.window, mid = now - 0.5 * steady_cfg_.window;
+  // Frames older than the window are never read again: dropped, but for the first, whose strain
+  // says how long the history is.
+  const auto old_end = std::find_if(hist_strain_.begin() + 1, hist_strain_.end(),
+                                    [&](double s) { return s >= start; });
+  const auto dropped = old_end - (hist_strain_.begin() + 1);
+  if (dropped > 0)
+    for (auto* v : {&hist_strain_, &hist_h_, &hist_mu_})
+      v->erase(v->begin() + 1, v->begin() + 1 + dropped);
   double h1 = 0, h2 = 0, m1 = 0, m2 = 0;
   int n1 = 0, n2 = 0;
   for (std::size_t k = 0; k < hist_strain_.size(); ++k) {
@@ -256,13 +278,26 @@ void PressureCellObserverOf<D>::finish(const Dynamics& d, nlohmann::json& js, H5
   js[summary_key::pressure_measured] = p_meas_ / w_;
   js[summary_key::measured_strain] = d.strain() - steady_at_;
   // The window's blocks span its frames, first to last: what `sheardiff analyse` sees too.
-  const double last = s_strain_.empty() ? d.strain() : s_strain_.back();
-  add_steady_errors(js, s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_, steady_at_, last,
-                    error_block_);
+  const double last = window_.samples() == 0 ? d.strain() : window_.last_time();
+  add_steady_errors(js, window_, steady_at_, last, error_block_);
   add_stationarity(
-      js, pressure_cell_stationarity(steady_cfg_, s_strain_, s_h_, s_mu_top_, s_mu_bottom_, s_drag_,
-                                     s_load_, steady_at_, last, error_block_));
+      js, pressure_cell_stationarity(steady_cfg_, window_, steady_at_, last, error_block_));
   (void)writer;
+}
+
+template <class D>
+void PressureCellObserverOf<D>::serialize_window(Archive& a) {
+  if (!a.loading() || a.layout() >= 7) return a.io(window_);
+  // Layout 6 kept every frame's samples of the window (strain, H, phi, mu_top, mu_bottom, net
+  // y drag, bulk load): binned as the run would have binned them.
+  std::vector<double> strain, h, phi, mu_top, mu_bottom, drag, load;
+  for (auto* v : {&strain, &h, &phi, &mu_top, &mu_bottom, &drag, &load}) a.io(*v);
+  for (auto* v : {&h, &phi, &mu_top, &mu_bottom, &drag, &load})
+    if (v->size() != strain.size())
+      throw std::runtime_error("checkpoint: the pressure cell's window samples differ in length");
+  window_ = cell_window(strain, h, phi, mu_top, mu_bottom, drag, load,
+                        -std::numeric_limits<double>::infinity(),
+                        std::numeric_limits<double>::infinity());
 }
 
 template class PressureCellObserverOf<Dim2>;

@@ -121,17 +121,61 @@ TEST(Stationarity, PressureCellNamesTheDriftingSignal) {
   const auto bottom = scaled(0.5, 0.05, 0.0), load = scaled(1.0, 0.05, 0.0);
   sd::SteadyStateParams cfg;
   const auto still = scaled(0.0, 0.05, 0.0), sinking = scaled(0.05, 0.05, 0.0);
-  const auto ok =
-      sd::pressure_cell_stationarity(cfg, t, h, top, bottom, still, load, kFrom, kTo, 3.0);
-  const auto bad =
-      sd::pressure_cell_stationarity(cfg, t, h, top, bottom, sinking, load, kFrom, kTo, 3.0);
+  const auto verdict = [&](const std::vector<double>& height, const std::vector<double>& drag) {
+    const sd::BinnedSeries w = sd::cell_window(t, height, {}, top, bottom, drag, load, kFrom, kTo);
+    return sd::pressure_cell_stationarity(cfg, w, kFrom, kTo, 3.0);
+  };
+  const auto ok = verdict(h, still);
+  const auto bad = verdict(h, sinking);
   EXPECT_TRUE(ok.stationary()) << ok.failed();
   EXPECT_FALSE(bad.stationary());
   EXPECT_EQ(bad.failed(), "net_drag_y");
   // A wall that keeps falling 0.09 d per strain (2.7 d over the window, the H noise 0.3 d).
   const auto falling = scaled(40.0, 0.3, -0.09);
-  const auto fell =
-      sd::pressure_cell_stationarity(cfg, t, falling, top, bottom, still, load, kFrom, kTo, 3.0);
+  const auto fell = verdict(falling, still);
   EXPECT_EQ(fell.failed(), "H_change");
   EXPECT_NEAR(fell.signals[2].value, -2.7, 0.5);
+}
+
+// A checkpoint of layout 6 kept every frame's sample of the window; this version bins them
+// (BinnedSeries), so a run checkpointed by the older sheardiff resumes: its samples are binned
+// on reading exactly as cell_window bins the same frames, and the state then saves and loads in
+// today's layout unchanged.
+TEST(Stationarity, PressureCellWindowOfLayoutSixIsBinnedOnReading) {
+  std::mt19937_64 rng(15);
+  const auto t = times();
+  const auto h = series(t, 0.5, 40.0, 0.0, rng), phi = series(t, 0.5, 0.8, 0.0, rng);
+  const auto top = series(t, 0.5, 0.5, 0.0, rng), bottom = series(t, 0.5, 0.5, 0.0, rng);
+  const auto drag = series(t, 0.5, 0.0, 0.0, rng), load = series(t, 0.5, 1.0, 0.0, rng);
+  // The layout-6 section: tag, the detector's history, ten scalars, the free-fall count, then
+  // the window's seven frame series.
+  sd::Archive old = sd::Archive::writer();
+  old.tag("pressure_cell");
+  std::vector<double> hist = {0.5, 1.0};
+  for (int k = 0; k < 3; ++k) old.io(hist);
+  for (double x : {kFrom, kFrom - 10.0, 30.0, 40.0, 0.8, 0.64, 0.5, 0.5, 1.0, 0.01}) old.io(x);
+  long free_fall = 0;
+  old.io(free_fall);
+  for (auto v : {t, h, phi, top, bottom, drag, load}) old.io(v);
+  sd::PressureCellObserverOf<sd::Dim2> cell(sd::Config{});
+  sd::Archive in = sd::Archive::reader(old.bytes(), 6);
+  cell.serialize(in);
+  EXPECT_TRUE(in.at_end());
+  const sd::BinnedSeries expected = sd::cell_window(t, h, phi, top, bottom, drag, load, kFrom, kTo);
+  ASSERT_EQ(cell.window().samples(), static_cast<long>(t.size()));
+  for (std::size_t s = 0; s < sd::CellSignal::count; ++s) {
+    const sd::BatchMeans a = sd::batch_means(expected, s, kFrom, t.back(), kBlocks);
+    const sd::BatchMeans b = sd::batch_means(cell.window(), s, kFrom, t.back(), kBlocks);
+    EXPECT_EQ(a.mean, b.mean) << "signal " << s;
+    EXPECT_EQ(a.err, b.err) << "signal " << s;
+  }
+  sd::Archive now = sd::Archive::writer();
+  cell.serialize(now);
+  sd::PressureCellObserverOf<sd::Dim2> again(sd::Config{});
+  sd::Archive back = sd::Archive::reader(now.bytes());
+  again.serialize(back);
+  EXPECT_TRUE(back.at_end());
+  EXPECT_EQ(again.window().samples(), cell.window().samples());
+  EXPECT_EQ(sd::batch_means(again.window(), sd::CellSignal::mu, kFrom, t.back(), kBlocks).err,
+            sd::batch_means(cell.window(), sd::CellSignal::mu, kFrom, t.back(), kBlocks).err);
 }

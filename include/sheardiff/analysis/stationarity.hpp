@@ -2,6 +2,8 @@
 #include <string>
 #include <vector>
 
+#include "sheardiff/analysis/uncertainty.hpp"
+
 namespace sheardiff {
 
 // Whether a measured window was stationary, judged by physical signals against their own noise
@@ -38,6 +40,15 @@ DriftSignal mean_within_tolerance(const std::string& name, const std::vector<dou
 DriftSignal trend_within_noise(const std::string& name, const std::vector<double>& t,
                                const std::vector<double>& x, double from, double to, long blocks,
                                double z);
+
+// The same three tests on batch means already formed (of samples or of binned samples,
+// BinnedSeries); `from`, `to` and `blocks` are those the means were formed over.
+DriftSignal mean_within_noise(const std::string& name, const BatchMeans& b, double expected,
+                              double z);
+DriftSignal mean_within_tolerance(const std::string& name, const BatchMeans& b, double expected,
+                                  double tolerance);
+DriftSignal trend_within_noise(const std::string& name, const BatchMeans& b, double from, double to,
+                               long blocks, double z);
 
 struct StationarityVerdict {
   std::vector<DriftSignal> signals;

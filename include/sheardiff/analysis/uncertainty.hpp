@@ -1,5 +1,6 @@
 #pragma once
 #include <Eigen/Core>
+#include <limits>
 #include <vector>
 
 #include "sheardiff/analysis/time_series.hpp"
@@ -23,6 +24,44 @@ struct BatchMeans {
 };
 BatchMeans batch_means(const std::vector<double>& t, const std::vector<double>& x, double t_from,
                        double t_to, long blocks);
+
+// Samples of several signals taken at common ascending times, kept in at most max_bins bins of
+// consecutive samples so that what a run carries (and checkpoints) does not grow with it: one
+// sample a bin while they fit, then, each time the bins are full, neighbouring bins joined
+// pairwise (a bin then holds 2^k samples). A bin keeps its samples' summed time and, per
+// signal, the sum and the number of its finite values.
+class BinnedSeries {
+ public:
+  BinnedSeries() = default;
+  // max_bins: even, >= 2.
+  explicit BinnedSeries(std::size_t signals, std::size_t max_bins = 2048);
+  // The next sample: its time (not before the last one's) and one value per signal.
+  void add(double t, const std::vector<double>& x);
+  std::size_t signals() const { return signals_; }
+  std::size_t bins() const { return n_.size(); }
+  long samples() const { return samples_; }
+  long samples_per_bin() const { return per_bin_; }
+  double last_time() const { return last_t_; }  // NaN before the first sample
+  // Bin k's mean time, and signal s's sum and count of finite values in it.
+  double time(std::size_t k) const { return t_sum_[k] / n_[k]; }
+  double sum(std::size_t k, std::size_t s) const { return sum_[k * signals_ + s]; }
+  double count(std::size_t k, std::size_t s) const { return count_[k * signals_ + s]; }
+  void serialize(Archive& a);
+
+ private:
+  std::size_t signals_ = 0, max_bins_ = 2;
+  long per_bin_ = 1, samples_ = 0;
+  double last_t_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> n_, t_sum_;    // per bin
+  std::vector<double> sum_, count_;  // bins x signals
+};
+
+// batch_means of signal s of binned samples: each bin enters the block of its mean time. While
+// every bin holds one sample this is batch_means of the samples, to the bit; once bins are
+// joined, a bin that straddles a block boundary lies wholly in one block (a shift of at most
+// half a bin, against blocks of many bins).
+BatchMeans batch_means(const BinnedSeries& x, std::size_t s, double t_from, double t_to,
+                       long blocks);
 
 // The MSD-slope diffusion coefficient D of frames y (frames x particles, spacing dt), fitted
 // over lags [lo, hi] by OLS of MSD against lag using every frame as a reference time, and its

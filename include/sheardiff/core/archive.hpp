@@ -15,10 +15,16 @@ namespace sheardiff {
 
 class Archive {
  public:
-  static Archive writer() { return Archive(false, {}); }
-  static Archive reader(std::vector<char> bytes) { return Archive(true, std::move(bytes)); }
+  // The state layout this sheardiff writes (the digit of a checkpoint's magic): a section whose
+  // shape changed reads an older layout's by asking layout().
+  static constexpr int kLayout = 7;
+  static Archive writer() { return Archive(false, {}, kLayout); }
+  static Archive reader(std::vector<char> bytes, int layout = kLayout) {
+    return Archive(true, std::move(bytes), layout);
+  }
 
   bool loading() const { return loading_; }
+  int layout() const { return layout_; }
   const std::vector<char>& bytes() const { return buf_; }
   bool at_end() const { return pos_ == buf_.size(); }
 
@@ -74,7 +80,8 @@ class Archive {
   }
 
  private:
-  Archive(bool loading, std::vector<char> bytes) : loading_(loading), buf_(std::move(bytes)) {}
+  Archive(bool loading, std::vector<char> bytes, int layout)
+      : loading_(loading), layout_(layout), buf_(std::move(bytes)) {}
   void check_length(std::uint64_t n, std::size_t bytes_each) const {
     if (n > (buf_.size() - pos_) / bytes_each)
       throw std::runtime_error("checkpoint: a length field of " + std::to_string(n) +
@@ -93,6 +100,7 @@ class Archive {
     }
   }
   bool loading_;
+  int layout_;
   std::vector<char> buf_;
   std::size_t pos_ = 0;
 };

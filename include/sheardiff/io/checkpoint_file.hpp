@@ -1,7 +1,7 @@
 #pragma once
 // The file format of DIR/checkpoint.bin: a header, then the run's archived state (Archive).
 //
-//   u64 22, "sheardiff-checkpoint-6"   (the magic, as Archive writes a string; the digit is
+//   u64 22, "sheardiff-checkpoint-7"   (the magic, as Archive writes a string; the digit is
 //                                        the layout of the state that follows)
 //   u64 payload length in bytes
 //   u32 CRC-32 (zlib) of the payload
@@ -13,13 +13,17 @@
 // the profiles observer's: a pressure-cell run of layout 2 or 3 is refused with that reason
 // (CheckpointStore), a simple-shear one resumes. Layout 5 adds, for the channel alone, the
 // heights its fluid layer's sparsity pattern was built from (ForceBalance::on_rebuild): a
-// layout-4 channel checkpoint resumes, not bit-identically.
+// layout-4 channel checkpoint resumes, not bit-identically. Layout 6 accumulates the diffusion
+// analysis (earlier layouts kept its frames: refused). Layout 7 keeps the pressure cell's window
+// samples in bounded bins (BinnedSeries); layout 6 kept every frame's, which are binned on
+// reading: a layout-6 pressure-cell checkpoint resumes.
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "sheardiff/config.hpp"
+#include "sheardiff/core/archive.hpp"
 
 namespace sheardiff {
 
@@ -34,9 +38,9 @@ std::uint32_t crc32_of(const std::vector<char>& bytes);
 std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload);
 
 struct CheckpointPayload {
-  std::vector<char> bytes;  // the archived state, after the magic
-  bool checksummed = true;  // false: a version 2 file, read without a check
-  int layout = 6;           // the state layout: 2 to 6 (the magic's digit)
+  std::vector<char> bytes;        // the archived state, after the magic
+  bool checksummed = true;        // false: a version 2 file, read without a check
+  int layout = Archive::kLayout;  // the state layout: 2 to 7 (the magic's digit)
 };
 
 // Reads and checks FILE: the magic, the length against the file size, the CRC. Throws

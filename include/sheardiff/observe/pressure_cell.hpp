@@ -2,28 +2,43 @@
 #include <vector>
 
 #include "sheardiff/analysis/stationarity.hpp"
+#include "sheardiff/analysis/uncertainty.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/observe/observer.hpp"
 #include "sheardiff/observe/profiles.hpp"
 
 namespace sheardiff {
 
-// Statistical errors of the steady window's H, phi, mu, mu_top, mu_bottom from frame samples
-// (batch means over blocks of `block` strain from `from` to `to`): *_err keys into summary.
-void add_steady_errors(nlohmann::json& js, const std::vector<double>& strain,
-                       const std::vector<double>& h, const std::vector<double>& phi,
-                       const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
-                       double from, double to, double block);
+// The measured window's signals, sampled frame by frame from the detection of steady state on,
+// in a BinnedSeries of this many signals, in this order: mu = (mu_top + mu_bottom) / 2 and
+// mu_top - mu_bottom are formed frame by frame; net_drag_y is the walls' load difference over
+// P Lx lz, bulk_load the bulk's normal load over P. Bounded bins keep a long run's state small.
+struct CellSignal {
+  enum : std::size_t { h, phi, mu_top, mu_bottom, mu, mu_difference, net_drag_y, bulk_load, count };
+};
+constexpr std::size_t kCellWindowBins = 2048;
+void add_cell_sample(BinnedSeries& window, double strain, double h, double phi, double mu_top,
+                     double mu_bottom, double net_drag_y, double bulk_load);
+// The window's series of frames in [from, to] (what the run's observer took, for `analyse`);
+// an empty phi, net_drag_y or bulk_load vector leaves that signal without values.
+BinnedSeries cell_window(const std::vector<double>& strain, const std::vector<double>& h,
+                         const std::vector<double>& phi, const std::vector<double>& mu_top,
+                         const std::vector<double>& mu_bottom,
+                         const std::vector<double>& net_drag_y,
+                         const std::vector<double>& bulk_load, double from, double to);
+
+// Statistical errors of the steady window's H, phi, mu, mu_top, mu_bottom (batch means over
+// blocks of `block` strain from `from` to `to`): *_err keys into summary.
+void add_steady_errors(nlohmann::json& js, const BinnedSeries& window, double from, double to,
+                       double block);
 
 // Whether the window [from, to] of a pressure cell was stationary: the net y drag on the discs
 // (the walls' load difference over P Lx lz) and mu_top - mu_bottom zero, and H without a trend,
 // each within steady.drift_z standard errors; the bulk's normal load P within
-// steady.bulk_load_tolerance. Samples as in add_steady_errors, blocks of `block` strain.
-StationarityVerdict pressure_cell_stationarity(
-    const SteadyStateParams& cfg, const std::vector<double>& strain, const std::vector<double>& h,
-    const std::vector<double>& mu_top, const std::vector<double>& mu_bottom,
-    const std::vector<double>& net_drag_y, const std::vector<double>& bulk_load, double from,
-    double to, double block);
+// steady.bulk_load_tolerance. Blocks as in add_steady_errors.
+StationarityVerdict pressure_cell_stationarity(const SteadyStateParams& cfg,
+                                               const BinnedSeries& window, double from, double to,
+                                               double block);
 // Its signals into summary.json: stationary, not_stationary (the failed signals), and each
 // signal's value and error (net_drag_y, mu_top_minus_bottom, H_change, bulk_normal_load).
 void add_stationarity(nlohmann::json& js, const StationarityVerdict& v);
@@ -53,11 +68,12 @@ class PressureCellObserverOf final : public ObserverOf<D> {
                       &p_meas_, &max_p_err_})
       a.io(*x);
     a.io(free_fall_steps_);
-    for (auto* v : {&s_strain_, &s_h_, &s_phi_, &s_mu_top_, &s_mu_bottom_, &s_drag_, &s_load_})
-      a.io(*v);
+    serialize_window(a);
   }
 
   bool steady() const { return steady_at_ >= 0.0; }
+  // The measured window's samples so far (CellSignal).
+  const BinnedSeries& window() const { return window_; }
   double steady_strain() const { return steady_from_; }
   // Bulk area (discs) or volume (spheres) fraction of the current configuration.
   static double bulk_phi(const Dynamics& d, double exclusion);
@@ -72,10 +88,9 @@ class PressureCellObserverOf final : public ObserverOf<D> {
   double w_ = 0, h_ = 0, phi_ = 0, phi2_ = 0, mu_top_ = 0, mu_bottom_ = 0, p_meas_ = 0;
   double max_p_err_ = 0;
   long free_fall_steps_ = 0;
-  // Frame samples of the steady window, for the error bars.
-  std::vector<double> s_strain_, s_h_, s_phi_, s_mu_top_, s_mu_bottom_;
-  // ... and of the stationarity signals (net y drag on the discs, the bulk's normal load).
-  std::vector<double> s_drag_, s_load_;
+  // The steady window's frame samples (CellSignal), for the error bars and the stationarity test.
+  BinnedSeries window_{CellSignal::count, kCellWindowBins};
+  void serialize_window(Archive& a);
 };
 
 using PressureCellObserver = PressureCellObserverOf<Dim2>;
