@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <string>
 
 #include "sheardiff/io/io_error.hpp"
 
@@ -14,16 +15,13 @@ namespace sheardiff {
 
 namespace {
 
-// The digit is the state layout (CheckpointPayload::layout); 3 to 7 share the header.
-constexpr char kMagic[] = "sheardiff-checkpoint-7";
-constexpr char kLayout6Magic[] = "sheardiff-checkpoint-6";
-constexpr char kLayout5Magic[] = "sheardiff-checkpoint-5";
-constexpr char kLayout4Magic[] = "sheardiff-checkpoint-4";
-constexpr char kLayout3Magic[] = "sheardiff-checkpoint-3";
-constexpr char kLegacyMagic[] = "sheardiff-checkpoint-2";
-constexpr std::uint64_t kMagicLength = sizeof(kMagic) - 1;
-static_assert(sizeof(kLegacyMagic) == sizeof(kMagic) && sizeof(kLayout3Magic) == sizeof(kMagic) &&
-              sizeof(kLayout6Magic) == sizeof(kMagic));
+// The digit is the state layout (CheckpointPayload::layout): "sheardiff-checkpoint-N". Layout 2
+// had no header; 3 to Archive::kLayout share it.
+static_assert(Archive::kLayout >= 3 && Archive::kLayout <= 9, "one digit of layout in the magic");
+std::string magic_of(int layout) {
+  return fmt::format("sheardiff-checkpoint-{}", layout);
+}
+constexpr std::uint64_t kMagicLength = 22;
 constexpr std::size_t kHeader = 8 + kMagicLength + 8 + 4;
 
 template <class T>
@@ -32,9 +30,9 @@ T load(const char* p) {
   std::memcpy(&x, p, sizeof(T));
   return x;
 }
-bool starts_with_magic(const std::vector<char>& b, const char* magic) {
+bool starts_with_magic(const std::vector<char>& b, const std::string& magic) {
   return b.size() >= 8 + kMagicLength && load<std::uint64_t>(b.data()) == kMagicLength &&
-         std::memcmp(b.data() + 8, magic, kMagicLength) == 0;
+         std::memcmp(b.data() + 8, magic.data(), kMagicLength) == 0;
 }
 
 }  // namespace
@@ -58,7 +56,7 @@ std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload) {
   const std::uint64_t magic_length = kMagicLength, length = payload.size();
   const std::uint32_t crc = crc32_of(payload);
   std::memcpy(p, &magic_length, 8);
-  std::memcpy(p + 8, kMagic, kMagicLength);
+  std::memcpy(p + 8, magic_of(Archive::kLayout).data(), kMagicLength);
   std::memcpy(p + 8 + kMagicLength, &length, 8);
   std::memcpy(p + 8 + kMagicLength + 8, &crc, 4);
   if (!payload.empty()) std::memcpy(p + kHeader, payload.data(), payload.size());
@@ -86,23 +84,18 @@ CheckpointPayload read_checkpoint_file(const std::filesystem::path& file) {
   }
   if (in.bad()) throw_io_error("read", file);
   CheckpointPayload out;
-  if (starts_with_magic(b, kLegacyMagic)) {
+  if (starts_with_magic(b, magic_of(2))) {
     out.checksummed = false;
     out.layout = 2;
     out.bytes.assign(b.begin() + 8 + kMagicLength, b.end());
     return out;
   }
-  if (starts_with_magic(b, kLayout3Magic))
-    out.layout = 3;
-  else if (starts_with_magic(b, kLayout4Magic))
-    out.layout = 4;
-  else if (starts_with_magic(b, kLayout5Magic))
-    out.layout = 5;
-  else if (starts_with_magic(b, kLayout6Magic))
-    out.layout = 6;
-  else if (!starts_with_magic(b, kMagic))
-    throw corrupt(
-        fmt::format("it does not begin with the magic \"{}\" ({} bytes)", kMagic, b.size()));
+  out.layout = 0;
+  for (int layout = 3; layout <= Archive::kLayout && out.layout == 0; ++layout)
+    if (starts_with_magic(b, magic_of(layout))) out.layout = layout;
+  if (out.layout == 0)
+    throw corrupt(fmt::format("it does not begin with the magic \"{}\" ({} bytes)",
+                              magic_of(Archive::kLayout), b.size()));
   if (b.size() < kHeader) throw corrupt(fmt::format("{} bytes, shorter than its header", b.size()));
   const auto length = load<std::uint64_t>(b.data() + 8 + kMagicLength);
   const auto stored = load<std::uint32_t>(b.data() + 8 + kMagicLength + 8);
