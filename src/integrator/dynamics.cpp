@@ -63,8 +63,9 @@ bool DynamicsOf<D>::resolve_with_sticking(double dt_implicit,
 }
 
 template <class D>
-int DynamicsOf<D>::stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched) {
-  return force_balance_.stick_reversed_sliding(particles_, neighbours_.pairs(), v.u, switched);
+int DynamicsOf<D>::stick_reversed_sliding(const Velocities& v, double dt,
+                                          std::vector<std::size_t>* switched) {
+  return force_balance_.stick_reversed_sliding(particles_, neighbours_.pairs(), v.u, dt, switched);
 }
 
 const char* to_string(StepLimit l) {

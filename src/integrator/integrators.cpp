@@ -74,7 +74,7 @@ bool ImplicitSpringsOf<D>::step(DynamicsOf<D>& d) {
     // (docs/low_j.md).
     // The re-solve adds only the switched contacts' tangential stiffness, a low-rank change
     // solved on the same factor (a new factorisation doubled the cost of a step).
-    for (int pass = 0; pass < kStickPasses && d.stick_reversed_sliding(last_, &switched_) > 0;
+    for (int pass = 0; pass < kStickPasses && d.stick_reversed_sliding(last_, dt, &switched_) > 0;
          ++pass) {
       if (!d.resolve_with_sticking(dt, switched_, last_)) return false;
       ++solves_;

@@ -79,7 +79,7 @@ void ForceBalanceOf<D>::cap_histories(const Particles& p, const Box& box,
 
 template <class D>
 int ForceBalanceOf<D>::stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
-                                              const std::vector<Body>& u,
+                                              const std::vector<Body>& u, double dt,
                                               std::vector<std::size_t>* switched) const {
   (void)p;
   if (switched) switched->clear();
@@ -89,7 +89,7 @@ int ForceBalanceOf<D>::stick_reversed_sliding(const Particles& p, std::vector<Pa
     if (!h.touching || !h.contact.sliding) continue;
     const PairTerm& t = terms_[k];
     const auto up = pair_velocity<D>(u[pairs[k].i], u[pairs[k].j] + t.image_j);
-    if (FrictionalContact::stick_if_unloading(h.contact, t.g, up)) {
+    if (contact().stick_after_slip(h.contact, t.g, up, dt)) {
       ++changed;
       if (switched) switched->push_back(k);
     }

@@ -218,8 +218,8 @@ TEST_P(PlaneRestriction, SpheresInOnePlaneMoveAsTheDiscs) {
     // on the old factor with low-rank terms (one per disc contact, two per sphere contact)
     // agrees again.
     std::vector<std::size_t> switched2, switched3;
-    const int n2 = d.stick_reversed_sliding(v2, &switched2);
-    const int n3 = fb.stick_reversed_sliding(p, list.pairs(), v3.u, &switched3);
+    const int n2 = d.stick_reversed_sliding(v2, dt, &switched2);
+    const int n3 = fb.stick_reversed_sliding(p, list.pairs(), v3.u, dt, &switched3);
     EXPECT_EQ(n2, n3);
     if (n2 > 0) {
       ASSERT_TRUE(d.resolve_with_sticking(dt, switched2, v2));

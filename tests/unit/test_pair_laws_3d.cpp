@@ -238,5 +238,38 @@ TEST(FrictionalContact3d, CoulombConeAndTurning) {
   EXPECT_NEAR(spring.dot(tilted), 0.0, 1e-18);
 }
 
+// Which sliding contacts stick once the step's slip s is solved (contact.stick_rule). The
+// stretch xi is at the cap; its trial value xi + s dt is inside the cone when shorter than xi.
+TEST(FrictionalContact3d, StickRules) {
+  FrictionalContact unloading{1e4, 5e3, 0.5, false};
+  FrictionalContact coulomb = unloading;
+  coulomb.stick_rule = FrictionalContact::StickRule::Coulomb;
+  const double cap = 1e-3, dt = 0.1;
+  const Space3 xi(cap, 0.0, 0.0);
+  const auto slip = [&](double along, double sideways) {  // displacement over dt, in caps
+    return Space3(along * cap / dt, sideways * cap / dt, 0.0);
+  };
+  // Turned sideways, slightly unloaded: outside the cone (|(0.8, 1.0)| > 1), no reversal
+  // through zero. Unloading sticks it (the spheres' extra switches); Coulomb leaves it sliding.
+  EXPECT_TRUE(unloading.sticks_3d(xi, slip(-0.2, 1.0), dt));
+  EXPECT_FALSE(coulomb.sticks_3d(xi, slip(-0.2, 1.0), dt));
+  // Inside the cone: both stick.
+  EXPECT_TRUE(unloading.sticks_3d(xi, slip(-0.5, 0.3), dt));
+  EXPECT_TRUE(coulomb.sticks_3d(xi, slip(-0.5, 0.3), dt));
+  // Through zero along xi, though outside the cone: both stick (left sliding it would flip to
+  // the opposite cap).
+  EXPECT_TRUE(coulomb.sticks_3d(xi, slip(-1.5, 2.0), dt));
+  // Loading further: neither.
+  EXPECT_FALSE(unloading.sticks_3d(xi, slip(0.5, 1.0), dt));
+  EXPECT_FALSE(coulomb.sticks_3d(xi, slip(0.5, 1.0), dt));
+  // Slip along xi, as between discs: the two rules are one, at every reversal (below twice the
+  // cap inside the cone, beyond it through zero).
+  for (const double a : {1e-6, 0.1, 0.99, 1.0, 1.5, 1.99, 2.0, 2.5, 10.0, 1e6}) {
+    EXPECT_TRUE(coulomb.sticks_3d(xi, slip(-a, 0.0), dt)) << a;
+    EXPECT_TRUE(unloading.sticks_3d(xi, slip(-a, 0.0), dt)) << a;
+    EXPECT_FALSE(coulomb.sticks_3d(xi, slip(a, 0.0), dt)) << a;
+  }
+}
+
 }  // namespace
 }  // namespace sheardiff

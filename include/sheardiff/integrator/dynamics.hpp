@@ -54,12 +54,14 @@ class DynamicsOf {
   void begin_step();
   // Velocities at the current configuration; dt_implicit > 0 for implicit springs.
   bool solve(double dt_implicit, Velocities& v);
-  // Implicit springs: a contact that entered the step sliding (its Coulomb force carried
-  // explicitly, no tangential stiffness) but whose solved slip v runs against its spring is not
-  // sliding in this step: it is marked sticking so that a re-solve gives it its tangential
-  // stiffness. Returns how many contacts changed (0: the sliding set is consistent with v).
-  // switched (optional): the indices of those contacts in neighbours().pairs().
-  int stick_reversed_sliding(const Velocities& v, std::vector<std::size_t>* switched = nullptr);
+  // Implicit springs: a contact that entered the step of length dt sliding (its Coulomb force
+  // carried explicitly, no tangential stiffness) but whose solved slip v releases its spring
+  // (contact.stick_rule) is not sliding in this step: it is marked sticking so that a re-solve
+  // gives it its tangential stiffness. Returns how many contacts changed (0: the sliding set is
+  // consistent with v). switched (optional): the indices of those contacts in
+  // neighbours().pairs().
+  int stick_reversed_sliding(const Velocities& v, double dt,
+                             std::vector<std::size_t>* switched = nullptr);
   // Solve again after stick_reversed_sliding at the same positions and dt: the new tangential
   // stiffness enters as low-rank terms on the last factor (ForceBalance::resolve_with_sticking).
   bool resolve_with_sticking(double dt_implicit, const std::vector<std::size_t>& switched,

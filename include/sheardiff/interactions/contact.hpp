@@ -23,11 +23,21 @@ struct FrictionalContact {
   // LF_DEM's convention: each pair's kn and kt scaled by its mean radius over the small one,
   // (a_i + a_j) / d (1, 1.2, 1.4 for small-small, small-large, large-large at 1 : 1.4).
   bool scale_with_radius = false;
+  // Which sliding contacts stick once the implicit step's slip s is solved (contact.stick_rule).
+  // A sliding contact's stretch xi is at the cap, so its trial stretch xi + s dt ends inside the
+  // cone when 2 xi . s + dt |s|^2 < 0. Unloading sticks every contact with xi . s < 0. Coulomb
+  // sticks those inside the cone and those whose slip along -xi exceeds |xi| (-xi . s dt >=
+  // |xi|^2): a reversal through zero, which left sliding would flip between +cap and -cap every
+  // step (docs/low_j.md). For discs (s parallel to xi) the two are the same set; for spheres
+  // Coulomb leaves sliding a contact whose slip turns its stretch sideways outside the cone.
+  enum class StickRule { Unloading, Coulomb };
+  StickRule stick_rule = StickRule::Unloading;
 
   static std::optional<FrictionalContact> from(const Config& cfg) {
     const double k = cfg.contact.ktilde;
-    return FrictionalContact{k, cfg.contact.kt_ratio * k, cfg.contact.mu,
-                             cfg.contact.stiffness == "mean_radius"};
+    return FrictionalContact{
+        k, cfg.contact.kt_ratio * k, cfg.contact.mu, cfg.contact.stiffness == "mean_radius",
+        cfg.contact.stick_rule == "coulomb" ? StickRule::Coulomb : StickRule::Unloading};
   }
 
   bool has_friction() const { return mu > 0.0 && kt > 0.0; }
@@ -112,8 +122,9 @@ struct FrictionalContact {
   void cap(History& h, const PairGeometry& g) const { h.sliding = apply_coulomb(g, h.xi); }
   // Implicit springs: a contact that entered the step sliding but whose solved slip u runs
   // against its stretch unloads its spring, so it sticks (Coulomb: |f_t| < mu f_n). Returns
-  // whether it changed.
-  static bool stick_if_unloading(History& h, const PairGeometry& g, const Vec6& u) {
+  // whether it changed. Both stick rules are this test for discs (s along xi: inside the cone
+  // for a reversal below 2 |xi|, through zero above |xi|), so dt is not needed.
+  bool stick_after_slip(History& h, const PairGeometry& g, const Vec6& u, double) const {
     if (!h.sliding || !(slip_rate(g, u) * h.xi < 0.0)) return false;
     h.sliding = false;
     return true;
@@ -192,8 +203,15 @@ struct FrictionalContact {
     turn_with_pair(h.xi, g.n);
     h.sliding = apply_coulomb_3d(g, h.xi);
   }
-  static bool stick_if_unloading(History3& h, const PairGeometry3& g, const Vec12& u) {
-    if (!h.sliding || !(slip_velocity_3d(g, u).dot(h.xi) < 0.0)) return false;
+  // The stick rule of spheres over a step dt (stick_rule above).
+  bool sticks_3d(const Space3& xi, const Space3& s, double dt) const {
+    const double along = xi.dot(s);
+    if (!(along < 0.0)) return false;
+    if (stick_rule == StickRule::Unloading) return true;
+    return 2.0 * along + dt * s.squaredNorm() < 0.0 || -along * dt >= xi.squaredNorm();
+  }
+  bool stick_after_slip(History3& h, const PairGeometry3& g, const Vec12& u, double dt) const {
+    if (!h.sliding || !sticks_3d(h.xi, slip_velocity_3d(g, u), dt)) return false;
     h.sliding = false;
     return true;
   }

@@ -10,7 +10,8 @@ struct ContactParams {
   double ktilde = 1e4;
   double kt_ratio = 0.5;
   double mu = 0.5;
-  std::string stiffness = "uniform";  // or "mean_radius" (kn, kt x (a_i + a_j) / d)
+  std::string stiffness = "uniform";     // or "mean_radius" (kn, kt x (a_i + a_j) / d)
+  std::string stick_rule = "unloading";  // or "coulomb" (FrictionalContact::StickRule)
 
   // Keys: the schema's section adapter (src/config.cpp), with real / boolean / choice.
   template <class Keys>
@@ -25,6 +26,14 @@ struct ContactParams {
              "Per-pair stiffness: `uniform` (every pair kn, kt) or `mean_radius` (LF_DEM's "
              "convention: kn, kt times (a_i + a_j) / d, so 1.2x for small-large and 1.4x for "
              "large-large pairs at size_ratio 1.4).");
+    k.choice("contact.stick_rule", {"unloading", "coulomb"}, &ContactParams::stick_rule,
+             "Implicit springs: which sliding contacts stick once the step's slip s is solved "
+             "(docs/model.md section 7). `unloading`: every one whose slip runs against its "
+             "stretch xi (xi . s < 0). `coulomb`: one whose trial stretch xi + s dt ends inside "
+             "the Coulomb cone, or whose slip along -xi carries the stretch through zero (a "
+             "reversal that would otherwise flip between opposite caps). The same test for "
+             "discs; for spheres `coulomb` leaves sliding a contact whose slip turns it sideways "
+             "without bringing it inside the cone.");
   }
 };
 

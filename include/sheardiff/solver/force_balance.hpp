@@ -113,11 +113,12 @@ class ForceBalanceOf {
                          std::vector<Pair>& pairs, const std::vector<Body>& u, double dt) const;
   // ... and their caps at its end (after the move).
   void cap_histories(const Particles& p, const Box& box, std::vector<Pair>& pairs) const;
-  // Implicit springs: contacts that entered the step sliding but whose solved slip unloads
-  // their spring stick (FrictionalContact::stick_if_unloading); returns how many changed and
-  // their indices into pairs in *switched (optional).
+  // Implicit springs: contacts that entered the step (of length dt) sliding and whose solved
+  // slip u releases their spring stick (FrictionalContact::stick_after_slip, by the contact's
+  // stick rule); returns how many changed and their indices into pairs in *switched (optional).
   int stick_reversed_sliding(const Particles& p, std::vector<Pair>& pairs,
-                             const std::vector<Body>& u, std::vector<std::size_t>* switched) const;
+                             const std::vector<Body>& u, double dt,
+                             std::vector<std::size_t>* switched) const;
 
   // Assemble at the current positions and solve. dt_implicit > 0 treats the springs linearly
   // implicitly over a step of that length. walls = nullptr when the scene has none; a floating
