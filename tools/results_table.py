@@ -20,7 +20,7 @@ run's own error bar, the ratio to the reference and the difference in combined s
 
     /usr/bin/python3 tools/results_table.py --compare REF_POINT POINT [POINT ...]
 
-(a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.0001_N=500_seed=1)
+(a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.01_N=500_seed=1)
 """
 import math
 import pathlib
