@@ -17,6 +17,10 @@ only; the seed's laws dashed black.
   (i) mu against J with mu_c + a J^b
   (j) D / (dv^2 Psi) for each Psi definition: which one makes D = dv^2 Psi hold
 
+A sweep of spheres (sweep.csv's dimension = 3) draws Boyer, Guazzelli & Pouliquen's (2011) fits
+in (d) and (i), the 3D experiments' phi(J) and mu(J); the seed's laws stay in the other panels
+as the 2D reference ("2D seed").
+
     /usr/bin/python3 tools/plot_sweep.py DIR [--out DIR/sweep.png]
 """
 import argparse
@@ -33,7 +37,21 @@ SEED = {  # seed Table 1 (suspensions) and eq. (3.3)
     "D_phi": (0.019, -0.61), "dv_phi": (0.25, -0.54), "psi_phi": (0.37, 0.51),
     "phi_c": 0.81, "phi_a": 0.64, "phi_b": 0.5, "step": 0.09,
 }
-CLOSE_PACKING_2D = 0.9069
+# Boyer, Guazzelli & Pouliquen, Phys. Rev. Lett. 107, 188301 (2011): pressure-imposed shear of
+# spheres, phi = phi_m / (1 + J^1/2), mu = mu_1 + (mu_2 - mu_1) / (1 + J_0 / J) + J + 5/2 phi_m J^1/2.
+BOYER = {"phi_m": 0.585, "mu_1": 0.32, "mu_2": 0.7, "J_0": 0.005}
+# Densest packings: the hexagonal one of discs, the face-centred cubic one of spheres. A fitted
+# phi_c above them is unphysical.
+CLOSE_PACKING = {2: 0.9069, 3: 0.7405}
+
+
+def boyer_phi(j):
+    return BOYER["phi_m"] / (1.0 + j ** 0.5)
+
+
+def boyer_mu(j):
+    b = BOYER
+    return b["mu_1"] + (b["mu_2"] - b["mu_1"]) / (1.0 + b["J_0"] / j) + j + 2.5 * b["phi_m"] * j ** 0.5
 
 
 def series_label(axes):
@@ -71,6 +89,11 @@ def main():
 
     fits = json.loads((args.sweep / "fits.json").read_text())
     rows = [r for r in csv.DictReader(open(args.sweep / "sweep.csv")) if r["status"] == "done"]
+    dims = {int(num(r, "dimension")) for r in rows if math.isfinite(num(r, "dimension"))}
+    if len(dims) > 1:
+        sys.exit(f"{args.sweep}: discs and spheres in one table; plot them apart")
+    dim = dims.pop() if dims else 2
+    ref = "seed" if dim == 2 else "2D seed"
     fig, ax = plt.subplots(3, 4, figsize=(19, 13))
     ax = ax.ravel()
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
@@ -141,9 +164,9 @@ def main():
         pf = f["phi_of_J"]
         x = None
         if "phi_c" in pf:
-            if pf["phi_c"] > CLOSE_PACKING_2D:
-                print(f"warning: {lab}: fitted phi_c = {pf['phi_c']:.3f} is above the 2D close "
-                      f"packing {CLOSE_PACKING_2D}: the dilatancy fit is unphysical",
+            if pf["phi_c"] > CLOSE_PACKING[dim]:
+                print(f"warning: {lab}: fitted phi_c = {pf['phi_c']:.3f} is above the {dim}D "
+                      f"close packing {CLOSE_PACKING[dim]}: the dilatancy fit is unphysical",
                       file=sys.stderr)
             jj = np.logspace(np.log10(J.min()), np.log10(J.max()), 40)
             ax[3].semilogx(jj, pf["phi_c"] - pf["a"] * jj ** pf["b"], "-", color=c, lw=0.9,
@@ -195,19 +218,25 @@ def main():
 
     jg = np.logspace(-4, -1, 40)
     a, b = SEED["D"]
-    ax[2].loglog(jg, a * jg ** b, "k--", label=f"seed: {a} J^{b}")
-    ax[3].semilogx(jg, SEED["phi_c"] - SEED["phi_a"] * jg ** SEED["phi_b"], "k--",
-                   label="seed: 0.81 - 0.64 J^0.5")
-    inset.loglog(jg, SEED["phi_a"] * jg ** SEED["phi_b"], "k--")
+    ax[2].loglog(jg, a * jg ** b, "k--", label=f"{ref}: {a} J^{b}")
+    if dim == 2:
+        ax[3].semilogx(jg, SEED["phi_c"] - SEED["phi_a"] * jg ** SEED["phi_b"], "k--",
+                       label="seed: 0.81 - 0.64 J^0.5")
+        inset.loglog(jg, SEED["phi_a"] * jg ** SEED["phi_b"], "k--")
+    else:
+        ax[3].semilogx(jg, boyer_phi(jg), "k--", label="Boyer et al. 2011: 0.585 / (1 + J^0.5)")
+        inset.loglog(jg, BOYER["phi_m"] - boyer_phi(jg), "k--")
+        ax[8].semilogx(jg, boyer_mu(jg), "k--", label="Boyer et al. 2011")
     inset.set(xlabel="J", ylabel=r"$\phi_c-\phi$")
     xg = np.logspace(np.log10(0.02), np.log10(0.25), 40)
-    ax[4].loglog(xg, SEED["D_phi"][0] * xg ** SEED["D_phi"][1], "k--", label="seed: 0.019 x^-0.61")
+    ax[4].loglog(xg, SEED["D_phi"][0] * xg ** SEED["D_phi"][1], "k--",
+                 label=f"{ref}: 0.019 x^-0.61")
     for key, style in (("dv", "k--"), ("psi", "k:")):
         a, b = SEED[key]
-        ax[5].loglog(jg, a * jg ** b, style, label=f"seed {key}: {a} J^{b}")
+        ax[5].loglog(jg, a * jg ** b, style, label=f"{ref} {key}: {a} J^{b}")
         a, b = SEED[key + "_phi"]
-        ax[6].loglog(xg, a * xg ** b, style, label=f"seed {key}: {a} x^{b}")
-    ax[7].axhline(SEED["step"], color="k", ls="--", label="seed: 0.09 d")
+        ax[6].loglog(xg, a * xg ** b, style, label=f"{ref} {key}: {a} x^{b}")
+    ax[7].axhline(SEED["step"], color="k", ls="--", label=f"{ref}: 0.09 d")
     ax[2].set(xlabel="J", ylabel=r"$D / \dot\gamma d^2$", title="(c) diffusion coefficient (fig. 1d)")
     ax[3].set(xlabel="J", ylabel=r"$\phi$", title="(d) dilatancy (fig. 2a)")
     ax[4].set(xlabel=r"$\phi_c - \phi$", ylabel=r"$D / \dot\gamma d^2$", title="(e) D against distance to jamming (fig. 2b)")

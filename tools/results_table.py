@@ -14,6 +14,10 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --laws DIR     # only the laws table (one group)
     /usr/bin/python3 tools/results_table.py --every-j DIR  # only every J against the seed's laws
 
+A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
+Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
+then the 2D reference for D, dv and Psi (the seed's phi law is a 2D one: not a reference).
+
 With --compare, single runs against a reference run (the checks of docs/results.md: one seed of
 another N, ktilde, mixing rule, ... against a point of the same seed): each quantity with the
 run's own error bar, the ratio to the reference and the difference in combined standard errors.
@@ -118,6 +122,8 @@ def main():
         sys.exit(f"{out}: fits.json has no J fits (a sweep without a flow.J axis, such as "
                  f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
+    dims = {r.get("dimension") for r in rows if r.get("dimension")}
+    spheres = dims == {"3"}
     if only:
         if len(fits["groups"]) != 1:
             sys.exit(f"{out}: {only} needs one group of points, not {len(fits['groups'])}")
@@ -149,16 +155,22 @@ def main():
                 cells.append(c)
             print(f"| {r['J']:g} | {r['runs']} | " + " | ".join(cells) + " |")
         print()
-        law_table(g["fits"], seed)
+        law_table(g["fits"], seed, dimension=3 if spheres else 2)
         print()
-        against_seed_laws(g["rows"])
+        against_seed_laws(g["rows"], dimension=3 if spheres else 2)
+        if spheres:
+            against_boyer(g["rows"])
     causes(done)
     cost(finished)
     if len(fits["groups"]) == 1:
         subrange_fits(done)
 
 
-def law_table(f, seed):
+# Densest packings: hexagonal discs, face-centred cubic spheres.
+CLOSE_PACKING = {2: 0.9069, 3: 0.7405}
+
+
+def law_table(f, seed, dimension=2):
     """The fitted laws of one group against the seed's Table 1, with verdicts."""
     print("| law | sheardiff: a, b (seed-bootstrap errors) | seed Table 1: a, b | a | b |")
     print("|---|---|---|---|---|")
@@ -177,7 +189,9 @@ def law_table(f, seed):
     if "phi_c" in p:
         e = p.get("phi_c_stderr")
         phi_c = f"{p['phi_c']:.4f}" + ("" if e is None else f" +- {e:.4f}")
-        warn = " (above the 2D close packing 0.9069: unphysical)" if p["phi_c"] > 0.9069 else ""
+        cp = CLOSE_PACKING[dimension]
+        warn = (f" (above the {dimension}D close packing {cp}: unphysical)" if p["phi_c"] > cp
+                else "")
         print(f"| phi = phi_c - a J^b | phi_c = {phi_c}"
               f"{warn}, a = {pm(p['a'], p.get('a_stderr'))}, b = {pm(p['b'], p.get('b_stderr'))} "
               f"| phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5 | phi_c: "
@@ -195,9 +209,43 @@ SEED_LAWS = {"phi": lambda J: 0.81 - 0.64 * math.sqrt(J), "D": lambda J: 0.024 *
              "dv": lambda J: 0.258 * J ** -0.25, "psi": lambda J: 0.35 * J ** 0.24}
 
 
-def against_seed_laws(rows, heading=True):
+# Boyer, Guazzelli & Pouliquen, Phys. Rev. Lett. 107, 188301 (2011): spheres in pressure-imposed
+# shear; phi_m = 0.585, mu_1 = 0.32, mu_2 = 0.7, J_0 = 0.005.
+BOYER_LAWS = {"phi": lambda J: 0.585 / (1.0 + math.sqrt(J)),
+              "mu": lambda J: 0.32 + 0.38 / (1.0 + 0.005 / J) + J + 2.5 * 0.585 * math.sqrt(J)}
+
+
+def against_boyer(rows):
+    """Spheres: per J, phi and mu (mean over seeds +- sem) against Boyer et al.'s fits there."""
+    print("#### Every J against Boyer, Guazzelli & Pouliquen (2011)\n")
+    print("Ours: mean over seeds +- standard error from their scatter (one seed: the run's own "
+          "error bar, in brackets); Boyer: phi_m / (1 + J^1/2) and mu_1 + (mu_2 - mu_1) / (1 + "
+          "J_0 / J) + J + 5/2 phi_m J^1/2 at the same J; ratio: ours / Boyer's.\n")
+    print("| J | seeds | phi | Boyer | ratio | mu | Boyer | ratio |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in sorted(rows, key=lambda r: r["J"]):
+        J = r["J"]
+        cells = []
+        for q, p in (("phi", 4), ("mu", 3)):
+            x, ref = r.get(q), BOYER_LAWS[q](J)
+            if x is None:
+                cells += ["-", fmt(ref, p), "-"]
+                continue
+            e = r.get(q + "_sem")
+            c = pm(x, e, p) if e is not None else pm(x, None, p) + (
+                f" [{r[q + '_run_err']:.2g}]" if r.get(q + "_run_err") is not None else "")
+            cells += [c, f"{ref:.{p}g}", f"{x / ref:.3f}"]
+        print(f"| {J:g} | {r['runs']} | " + " | ".join(cells) + " |")
+    print()
+
+
+def against_seed_laws(rows, heading=True, dimension=2):
     """Per J: ours (mean over seeds +- sem), the seed's law there, and ours over the seed's."""
-    if heading:
+    if heading and dimension == 3:
+        print("#### Every J against the seed's (2D) laws\n")
+        print("Spheres against the discs' laws: a 3D packing is not expected to follow the seed's "
+              "phi (its phi_c is that of discs); D, dv and Psi compare the two dimensions.\n")
+    elif heading:
         print("#### Every J against the seed's laws\n")
         print("Ours: mean over seeds +- standard error from their scatter; seed: its Table 1 law "
               "(phi: eq. 3.3, 0.81 - 0.64 J^1/2) at the same J; ratio: ours / seed's (phi: the "
@@ -234,10 +282,12 @@ def subrange_fits(done, replicates=2000):
     by_j = {}
     for r in done:
         try:
-            by_j.setdefault(float(r["J"]), []).append(
-                {q: float(r[q]) for q in ("D", "dv", "psi", "phi")})
+            v = {q: float(r[q]) for q in ("D", "dv", "psi", "phi")}
         except (KeyError, ValueError):
             continue
+        # A run without the diffusion analysis has no D, dv, Psi to fit.
+        if all(math.isfinite(x) for x in v.values()):
+            by_j.setdefault(float(r["J"]), []).append(v)
     js = sorted(by_j)
     if len(js) < 4:
         return
