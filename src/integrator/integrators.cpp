@@ -69,9 +69,10 @@ bool ImplicitSpringsOf<D>::step(DynamicsOf<D>& d) {
     ++solves_;
     // Sliding contacts whose explicit Coulomb force reversed their slip stick instead and the
     // step is solved again with their tangential stiffness (a few passes: contacts only ever
-    // go from sliding to sticking here). Without this, at steps where the cap force reverses
-    // the slip by more than the cap in one step, such contacts chatter between +cap and -cap
-    // (docs/low_j.md).
+    // go from sliding to sticking here). Which slips count as reversed is contact.stick_rule
+    // (FrictionalContact::stick_after_slip; the rules differ only between spheres). Without
+    // this, at steps where the cap force reverses the slip by more than the cap in one step,
+    // such contacts chatter between +cap and -cap (docs/low_j.md).
     // The re-solve adds only the switched contacts' tangential stiffness, a low-rank change
     // solved on the same factor (a new factorisation doubled the cost of a step).
     for (int pass = 0; pass < kStickPasses && d.stick_reversed_sliding(last_, dt, &switched_) > 0;
