@@ -167,6 +167,52 @@ BENCHMARK(cholmod_low_rank_columns<true>)
     ->ArgsProduct({{1000, 4000}, {1, 8, 32, 64}})
     ->Unit(benchmark::kMillisecond);
 
+// The matrix of spheres (scene.dimension = 3): the pressure cell of N spheres started at random at
+// volume fraction 0.55 (the cell of configs/sweep_3d.toml, J = 1e-3), 30 steps, factorised with
+// an ordering (0 AMD, 1 nested dissection, 2 METIS) and CHOLMOD's supernode relaxation (nrelax,
+// zrelax) times relax / 10: whether the discs' tuning (tune_cholmod: nested dissection, relaxation
+// doubled) holds for the spheres' larger separators (docs/performance.md, "Spheres").
+const Problem& problem_spheres(int n) {
+  static std::map<int, Problem> cache;
+  auto it = cache.find(n);
+  if (it != cache.end()) return it->second;
+  sheardiff::Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.scene.dimension = 3;
+  cfg.particles.n = n;
+  cfg.particles.aspect = 1.5;
+  cfg.particles.phi_init_spheres = 0.55;
+  cfg.flow.j = 1e-3;
+  cfg.contact.ktilde = 1e4;
+  sheardiff::Simulation3 sim(cfg);
+  for (int k = 0; k < 30; ++k) sim.step();
+  Problem p;
+  const auto& rs = sim.dynamics().force_balance().system();
+  p.lower = rs.matrix();
+  p.full = p.lower.selfadjointView<Eigen::Lower>();
+  p.rhs = rs.rhs();
+  return cache.emplace(n, std::move(p)).first->second;
+}
+
+void cholmod_spheres(benchmark::State& state) {
+  const Problem& p = problem_spheres(static_cast<int>(state.range(0)));
+  Supernodal solver;
+  cholmod_common& c = solver.cholmod();
+  c.nmethods = 1;
+  constexpr int kOrdering[] = {CHOLMOD_AMD, CHOLMOD_NESDIS, CHOLMOD_METIS};
+  c.method[0].ordering = kOrdering[state.range(1)];
+  const double relax = static_cast<double>(state.range(2)) / 10.0;
+  for (int k = 0; k < 3; ++k) {
+    c.nrelax[k] = static_cast<std::size_t>(static_cast<double>(c.nrelax[k]) * relax);
+    c.zrelax[k] *= relax;
+  }
+  time_factorise(state, p, solver);
+  state.counters["nnz_L"] = c.lnz;
+}
+BENCHMARK(cholmod_spheres)
+    ->ArgsProduct({{500, 1000, 2000}, {0, 1, 2}, {0, 2, 5, 10, 20}})
+    ->Unit(benchmark::kMillisecond);
+
 using CholSimplicial = Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
 BENCHMARK(factorise<CholSimplicial>)
     ->Name("cholmod_simplicial_llt")

@@ -124,7 +124,7 @@ const ResistanceSystem& assembled(Prepared& p) {
 void factorisation(benchmark::State& state) {
   Prepared& p = prepared(static_cast<int>(state.range(0)));
   const auto& a = assembled(p).matrix();
-  auto llt = make_sparse_cholesky(p.cfg.solver.cholesky);
+  auto llt = make_sparse_cholesky(p.cfg.solver.cholesky, 3);
   llt->analyze(a);
   for (auto _ : state) benchmark::DoNotOptimize(llt->factorize(a));
   label(state, p);
@@ -133,7 +133,7 @@ void factorisation(benchmark::State& state) {
 void back_substitution(benchmark::State& state) {
   Prepared& p = prepared(static_cast<int>(state.range(0)));
   const auto& rs = assembled(p);
-  auto llt = make_sparse_cholesky(p.cfg.solver.cholesky);
+  auto llt = make_sparse_cholesky(p.cfg.solver.cholesky, 3);
   llt->analyze(rs.matrix());
   llt->factorize(rs.matrix());
   for (auto _ : state) {

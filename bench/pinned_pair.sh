@@ -8,17 +8,21 @@
 # rounds a core's own speed cancels from it (on this VM one core has run 25 % slower than the
 # other for minutes). Stop anything else running on the machine first.
 #
-#   bench/pinned_pair.sh OLD_BINARY NEW_BINARY [N J STRAIN ROUNDS]   (default 1000 1e-4 0.3 2)
+#   bench/pinned_pair.sh OLD_BINARY NEW_BINARY [N J STRAIN ROUNDS [KEY=VALUE ...]]
+#   (default 1000 1e-4 0.3 2; each KEY=VALUE is passed to both runs as --set, e.g.
+#   scene.dimension=3 particles.aspect=1.5 particles.phi_init_spheres=0.52 for spheres)
 set -euo pipefail
 a=$(realpath "$1"); b=$(realpath "$2"); n=${3:-1000}; j=${4:-1e-4}; strain=${5:-0.3}
 rounds=${6:-2}
+extra=()
+for kv in "${@:7}"; do extra+=(--set "$kv"); done
 root=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 start() {  # binary core tag
   taskset -c "$2" /usr/bin/time -f "%U %S" -o "$work/time$3" "$1" run \
     "$root/configs/pressure_shear.toml" --out "$work/run$3" --overwrite -q \
     --set particles.N="$n" --set flow.J="$j" --set run.strain="$strain" \
-    --set analysis.diffusion=false > /dev/null 2>&1
+    --set analysis.diffusion=false "${extra[@]}" > /dev/null 2>&1
 }
 logsum=0
 for round in $(seq 1 "$rounds"); do

@@ -22,7 +22,7 @@ template <class D>
 ForceBalanceOf<D>::ForceBalanceOf(PairLaws laws, int dof, bool implicit_springs,
                                   const std::string& cholesky)
     : laws_(std::move(laws)),
-      system_(dof, cholesky),
+      system_(dof, cholesky, D::space),
       diagonal_only_(!laws_.resistive() && !implicit_springs) {}
 
 template <class D>

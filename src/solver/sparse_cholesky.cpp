@@ -52,13 +52,13 @@ class SupernodalWithFactor : public Supernodal {
 // time (bench_solver: sheardiff_cholmod against cholmod_supernodal_tuned).
 class Cholmod final : public SparseCholesky {
  public:
-  Cholmod() {
+  explicit Cholmod(int dimension) {
     if (openblas_set_num_threads) openblas_set_num_threads(1);
-    tune_cholmod(ordering_.cholmod());
+    tune_cholmod(ordering_.cholmod(), dimension);
     // Only its P is used: a simplicial analysis orders and postorders the same way and skips
     // the supernodal symbolic factor that natural_ computes anyway.
     ordering_.cholmod().supernodal = CHOLMOD_SIMPLICIAL;
-    tune_cholmod(natural_.cholmod());
+    tune_cholmod(natural_.cholmod(), dimension);
     natural_.cholmod().nmethods = 1;
     natural_.cholmod().method[0].ordering = CHOLMOD_NATURAL;
     // P already holds CHOLMOD's postorder of the elimination tree.
@@ -131,14 +131,18 @@ class Cholmod final : public SparseCholesky {
 
 }  // namespace
 
-void tune_cholmod(cholmod_common& c) {
-  // The matrix is the contact graph of a 2D packing: nested dissection (CHOLMOD's NESDIS) gives
-  // 20-27% fewer factorisation flops than AMD, and supernodes relaxed twice as far as CHOLMOD's
-  // defaults trade a few explicit zeros for fewer, larger BLAS calls. Together -13 % and -11 % per
-  // factorisation at N = 1000 and 4000 (bench/bench_solver, docs/performance.md); the costlier
-  // analysis is paid once per neighbour rebuild.
+void tune_cholmod(cholmod_common& c, int dimension) {
+  // The matrix is the contact graph of a packing: for discs nested dissection (CHOLMOD's NESDIS)
+  // gives 20-27% fewer factorisation flops than AMD, and supernodes relaxed twice as far as
+  // CHOLMOD's defaults trade a few explicit zeros for fewer, larger BLAS calls. Together -13 % and
+  // -11 % per factorisation at N = 1000 and 4000 (bench/bench_solver, docs/performance.md); the
+  // costlier analysis is paid once per neighbour rebuild. A packing of spheres has larger
+  // separators, so its supernodes are large already: relaxing them further only adds zeros
+  // (7-13 % slower at N = 1000 and 2000, bench_solver's cholmod_spheres), so spheres keep
+  // CHOLMOD's relaxation.
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_NESDIS;
+  if (dimension == 3) return;
   for (int k = 1; k < 3; ++k) {
     c.nrelax[k] *= 2;
     c.zrelax[k] *= 2.0;
@@ -146,8 +150,8 @@ void tune_cholmod(cholmod_common& c) {
   c.nrelax[0] *= 2;
 }
 
-std::unique_ptr<SparseCholesky> make_sparse_cholesky(const std::string& kind) {
-  if (kind == "cholmod") return std::make_unique<Cholmod>();
+std::unique_ptr<SparseCholesky> make_sparse_cholesky(const std::string& kind, int dimension) {
+  if (kind == "cholmod") return std::make_unique<Cholmod>(dimension);
   if (kind == "eigen")
     return std::make_unique<
         EigenBacked<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>>("eigen");

@@ -24,8 +24,9 @@ namespace sheardiff {
 // list: pairs out of range keep their structural zeros.
 class ResistanceSystem final : public SystemEntries {
  public:
-  explicit ResistanceSystem(int dof = 3, const std::string& cholesky = "cholmod")
-      : dof_(dof), llt_(make_sparse_cholesky(cholesky)) {}
+  // dimension: of the packing (2 discs, 3 spheres), for the factorisation's tuning.
+  explicit ResistanceSystem(int dof = 3, const std::string& cholesky = "cholmod", int dimension = 2)
+      : dof_(dof), llt_(make_sparse_cholesky(cholesky, dimension)) {}
 
   int dof() const { return dof_; }
   std::size_t unknowns() const { return static_cast<std::size_t>(dof_) * n_ + extra_; }

@@ -20,8 +20,8 @@ class SparseCholesky {
   virtual double solves_per_factorisation() const { return 0.0; }
 };
 
-// "cholmod": CHOLMOD supernodal LLT (SuiteSparse; fastest, see docs/performance.md);
-// "eigen": Eigen's SimplicialLLT.
-std::unique_ptr<SparseCholesky> make_sparse_cholesky(const std::string& kind);
+// "cholmod": CHOLMOD supernodal LLT (SuiteSparse; fastest, see docs/performance.md), tuned for
+// the matrices of discs (dimension 2) or spheres (3); "eigen": Eigen's SimplicialLLT.
+std::unique_ptr<SparseCholesky> make_sparse_cholesky(const std::string& kind, int dimension = 2);
 
 }  // namespace sheardiff

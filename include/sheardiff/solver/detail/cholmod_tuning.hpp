@@ -5,8 +5,8 @@
 
 namespace sheardiff {
 
-// The ordering and supernode settings sheardiff uses for CHOLMOD (measured, see
-// src/solver/sparse_cholesky.cpp).
-void tune_cholmod(cholmod_common& c);
+// The ordering and supernode settings sheardiff uses for CHOLMOD on the matrix of discs
+// (dimension 2) or spheres (3) (measured, see src/solver/sparse_cholesky.cpp).
+void tune_cholmod(cholmod_common& c, int dimension = 2);
 
 }  // namespace sheardiff
