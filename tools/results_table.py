@@ -13,6 +13,8 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py DIR
     /usr/bin/python3 tools/results_table.py --laws DIR     # only the laws table (one group)
     /usr/bin/python3 tools/results_table.py --every-j DIR  # only every J against the seed's laws
+    /usr/bin/python3 tools/results_table.py --means DIR    # only the means over seeds at every J
+    /usr/bin/python3 tools/results_table.py --boyer DIR    # only every J against Boyer et al.
 
 A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
 Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
@@ -105,11 +107,13 @@ def main():
             sys.exit(f"usage: {sys.argv[0]} --compare REF_POINT POINT [POINT ...]")
         compare(sys.argv[2:])
         return
-    only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in ("--laws", "--every-j") else None
+    modes = ("--laws", "--every-j", "--means", "--boyer")
+    only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
     if only:
         del sys.argv[1]
     if len(sys.argv) != 2:
-        sys.exit(f"usage: {sys.argv[0]} [--laws | --every-j] DIR (a sweep folder or results/<name>)")
+        sys.exit(f"usage: {sys.argv[0]} [{' | '.join(modes)}] DIR (a sweep folder or "
+                 f"results/<name>)")
     out = pathlib.Path(sys.argv[1])
     if not out.is_dir():
         sys.exit(f"{out}: not a directory")
@@ -128,7 +132,14 @@ def main():
         if len(fits["groups"]) != 1:
             sys.exit(f"{out}: {only} needs one group of points, not {len(fits['groups'])}")
         g = fits["groups"][0]
-        law_table(g["fits"], seed) if only == "--laws" else against_seed_laws(g["rows"], False)
+        if only == "--laws":
+            law_table(g["fits"], seed, dimension=3 if spheres else 2)
+        elif only == "--every-j":
+            against_seed_laws(g["rows"], False)
+        elif only == "--means":
+            means_table(g["rows"])
+        else:
+            against_boyer(g["rows"], False)
         return
     # Measurements that enter the fits; every finished run counts for the cost.
     # (`sheardiff fit --include-not-stationary` fits the flagged windows too: so does this.)
@@ -144,16 +155,7 @@ def main():
         print(f"#### {axes}\n")
         print("Each cell: mean over seeds +- standard error of that mean (from the seeds' "
               "scatter); [the runs' own error bars, rms / sqrt(n)].\n")
-        print("| J | seeds | phi | mu | D / (gammadot d^2) | dv / (gammadot d) | Psi gammadot |")
-        print("|---|---|---|---|---|---|---|")
-        for r in sorted(g["rows"], key=lambda r: r["J"]):
-            cells = []
-            for q, p in (("phi", 4), ("mu", 3), ("D", 3), ("dv", 3), ("psi", 3)):
-                c = pm(r.get(q), r.get(q + "_sem"), p)
-                if r.get(q + "_run_err") is not None:
-                    c += f" [{r[q + '_run_err']:.2g}]"
-                cells.append(c)
-            print(f"| {r['J']:g} | {r['runs']} | " + " | ".join(cells) + " |")
+        means_table(g["rows"])
         print()
         law_table(g["fits"], seed, dimension=3 if spheres else 2)
         print()
@@ -168,6 +170,20 @@ def main():
 
 # Densest packings: hexagonal discs, face-centred cubic spheres.
 CLOSE_PACKING = {2: 0.9069, 3: 0.7405}
+
+
+def means_table(rows):
+    """Per J: phi, mu, D, dv, Psi, each the mean over seeds +- sem [the runs' own error]."""
+    print("| J | seeds | phi | mu | D / (gammadot d^2) | dv / (gammadot d) | Psi gammadot |")
+    print("|---|---|---|---|---|---|---|")
+    for r in sorted(rows, key=lambda r: r["J"]):
+        cells = []
+        for q, p in (("phi", 4), ("mu", 3), ("D", 3), ("dv", 3), ("psi", 3)):
+            c = pm(r.get(q), r.get(q + "_sem"), p)
+            if r.get(q + "_run_err") is not None:
+                c += f" [{r[q + '_run_err']:.2g}]"
+            cells.append(c)
+        print(f"| {r['J']:g} | {r['runs']} | " + " | ".join(cells) + " |")
 
 
 def law_table(f, seed, dimension=2):
@@ -215,12 +231,13 @@ BOYER_LAWS = {"phi": lambda J: 0.585 / (1.0 + math.sqrt(J)),
               "mu": lambda J: 0.32 + 0.38 / (1.0 + 0.005 / J) + J + 2.5 * 0.585 * math.sqrt(J)}
 
 
-def against_boyer(rows):
+def against_boyer(rows, heading=True):
     """Spheres: per J, phi and mu (mean over seeds +- sem) against Boyer et al.'s fits there."""
-    print("#### Every J against Boyer, Guazzelli & Pouliquen (2011)\n")
-    print("Ours: mean over seeds +- standard error from their scatter (one seed: the run's own "
-          "error bar, in brackets); Boyer: phi_m / (1 + J^1/2) and mu_1 + (mu_2 - mu_1) / (1 + "
-          "J_0 / J) + J + 5/2 phi_m J^1/2 at the same J; ratio: ours / Boyer's.\n")
+    if heading:
+        print("#### Every J against Boyer, Guazzelli & Pouliquen (2011)\n")
+        print("Ours: mean over seeds +- standard error from their scatter (one seed: the run's "
+              "own error bar, in brackets); Boyer: phi_m / (1 + J^1/2) and mu_1 + (mu_2 - mu_1) / (1 + "
+              "J_0 / J) + J + 5/2 phi_m J^1/2 at the same J; ratio: ours / Boyer's.\n")
     print("| J | seeds | phi | Boyer | ratio | mu | Boyer | ratio |")
     print("|---|---|---|---|---|---|---|---|")
     for r in sorted(rows, key=lambda r: r["J"]):
