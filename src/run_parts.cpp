@@ -346,7 +346,6 @@ nlohmann::json run_summary(const Config& cfg, RunningStateOf<D>& run, double wal
     js[summary_key::sticking_resolves_per_step] = {
         {"low_rank", static_cast<double>(sc.low_rank) / steps},
         {"refactorised_budget", static_cast<double>(sc.refactorised_budget) / steps},
-        {"refactorised_wall", static_cast<double>(sc.refactorised_wall) / steps},
         {"switched_contacts", static_cast<double>(sc.switched) / steps}};
   }
   {

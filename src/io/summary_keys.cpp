@@ -50,9 +50,8 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
            {sk::sticking_resolves_per_step, "per step",
             "object, the cost of the implicit integrator's sticking re-solves per step: `low_rank` "
             "(passes solved on the old factor with low-rank updates), `refactorised_budget` "
-            "(passes refactorised because the update would cost more), `refactorised_wall` "
-            "(passes refactorised because a switched contact touches the floating wall), "
-            "`switched_contacts` (contacts switched from sliding to sticking)"},
+            "(passes refactorised because the update would cost more), `switched_contacts` "
+            "(contacts switched from sliding to sticking)"},
            {sk::dt_limited_by, "fraction of steps",
             "object: for each step limit that ever set dt, the share of steps it set: `fixed` "
             "(fixed `integrator.dt`), `strain` (`max_strain_step`), `displacement`, `gap`, "

@@ -153,16 +153,13 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
                                               const std::vector<std::size_t>& switched,
                                               double dt_implicit, const WallBodies* walls,
                                               Velocities& out) {
-  // A fresh assembly reads the contacts' new state: taken when a contact with the floating wall
-  // switched (its column is not a low-rank term), or when the update would cost more
+  // A fresh assembly reads the contacts' new state when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
   constexpr std::size_t kRows = D::space == 2 ? 1 : 2;
   const bool over_budget = !system_.low_rank_pays(kRows * switched.size());
-  bool wall = false;
-  for (std::size_t k : switched) wall = wall || p.motion[pairs[k].j] == Motion::FloatingWall;
   sticking_.switched += static_cast<long>(switched.size());
-  if (over_budget || wall) {
-    ++(over_budget ? sticking_.refactorised_budget : sticking_.refactorised_wall);
+  if (over_budget) {
+    ++sticking_.refactorised_budget;
     return solve(p, box, flow, pairs, dt_implicit, walls, out);
   }
   ++sticking_.low_rank;
@@ -173,12 +170,13 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
     const double kt = dt_implicit * contact().kt_of(term.g);
-    const bool j_mobile = p.motion[pr.j] == Motion::Mobile;
-    // Known velocity of j's side: the Lees-Edwards image's, a driven wall's, or zero for a
-    // fixed wall.
-    const double known_x = j_mobile                               ? term.image_j.x()
-                           : p.motion[pr.j] == Motion::DrivenWall ? walls->driven_vx
-                                                                  : 0.0;
+    const Motion mj = p.motion[pr.j];
+    const bool j_mobile = mj == Motion::Mobile, j_floating = mj == Motion::FloatingWall;
+    // Known velocity of j's side: the Lees-Edwards image's, the top wall's driven x velocity
+    // (a floating wall's y velocity is the unknown V), or zero for a fixed wall.
+    const double known_x = j_mobile                                 ? term.image_j.x()
+                           : j_floating || mj == Motion::DrivenWall ? walls->driven_vx
+                                                                    : 0.0;
     term.sliding = false;
     for (const auto& row : slip_rows(term.g)) {
       // The pair term as a new assembly would make it (stresses read it after the step).
@@ -194,7 +192,9 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
           dg[d * pr.j + r] = -kt * row[B + r] * wj_known;
         }
       }
-      system_.add_low_rank(w, kt, dg);
+      // The floating wall's y velocity is row[B + 1]'s unknown: its part goes to the border.
+      const double w_wall = j_floating ? row[B + 1] : 0.0;
+      system_.add_low_rank(w, kt, dg, w_wall, -kt * w_wall * wj_known);
     }
   }
   return solve_assembled(p, flow, walls, out);

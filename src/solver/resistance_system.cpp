@@ -72,9 +72,16 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<PairO
   ++analyses_;
 }
 
-void ResistanceSystem::add_low_rank(const VecX& w, double k, const VecX& dg) {
+void ResistanceSystem::add_low_rank(const VecX& w, double k, const VecX& dg, double w_wall,
+                                    double wall_rhs_change) {
   if (!factor_of_a_ || diagonal_only_)
     throw std::logic_error("ResistanceSystem: low-rank terms need the factor of A");
+  if (w_wall != 0.0) {
+    b_ += (k * w_wall) * w;
+    c_ += k * w_wall * w_wall;
+    a_inverse_b_.resize(0);
+  }
+  wall_rhs_ += wall_rhs_change;
   LowRankTerm t{{}, k};
   for (Eigen::Index i = 0; i < w.size(); ++i)
     if (w[i] != 0.0) t.w.emplace_back(i, w[i]);
@@ -254,8 +261,7 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
   } else {
     if (!prepare()) return false;
     u = apply_inverse(g_);
-    // The wall column is the same in every sticking pass on one factor (a switched contact
-    // with the wall refactorises): its A^-1 b is solved once per factorisation.
+    // A^-1 b of the factor is kept until a sticking pass changes the wall column.
     u1 = apply_inverse(b_, &a_inverse_b_);
   }
   // Schur complement of the bordered system [[A, b], [b^T, c]].

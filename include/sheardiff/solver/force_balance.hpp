@@ -130,7 +130,7 @@ class ForceBalanceOf {
   // Implicit springs: the contacts `switched` (indices into pairs) have just been marked
   // sticking after a solve at the same positions and dt_implicit; solves again with their
   // tangential stiffness added as low-rank terms to the factor of the last solve (no new
-  // assembly or factorisation; a full solve() if one of them touches the floating wall).
+  // assembly or factorisation; a full solve() when they would cost more than one).
   bool resolve_with_sticking(const Particles& p, const Box& box, const ImposedFlow& flow,
                              const std::vector<Pair>& pairs,
                              const std::vector<std::size_t>& switched, double dt_implicit,
@@ -153,16 +153,18 @@ class ForceBalanceOf {
   const FrictionalContact& contact() const { return *laws_.get<FrictionalContact>(); }
   // What the sticking re-solves cost (resolve_with_sticking): passes solved on the old factor
   // with low-rank terms, passes refactorised because their switched contacts would cost more
-  // back-substitutions than a factorisation, or because one touches the floating wall, and the
-  // contacts switched in all of them.
+  // back-substitutions than a factorisation, and the contacts switched in all of them.
+  // retired_wall: checkpoint layout 7's count of passes refactorised because a switched contact
+  // touched the floating wall (such contacts are low-rank terms now), read and written so that
+  // the layout stays, not reported.
   struct StickingCounts {
-    long low_rank = 0, refactorised_budget = 0, refactorised_wall = 0, switched = 0;
+    long low_rank = 0, refactorised_budget = 0, retired_wall = 0, switched = 0;
   };
   const StickingCounts& sticking_counts() const { return sticking_; }
   // The work counters, for checkpoints (after the system's, as a later layout's addition).
   void serialize_sticking_counts(Archive& a) {
-    a.io(sticking_.low_rank), a.io(sticking_.refactorised_budget),
-        a.io(sticking_.refactorised_wall), a.io(sticking_.switched);
+    a.io(sticking_.low_rank), a.io(sticking_.refactorised_budget), a.io(sticking_.retired_wall),
+        a.io(sticking_.switched);
   }
   // |A U + b V - g| / |g| of the last solve.
   double last_residual() const { return residual_; }

@@ -75,8 +75,12 @@ class ResistanceSystem final : public SystemEntries {
 
   // After a solve: the matrix becomes A + k w w^T (w over the unknowns) and the right-hand side
   // g + dg, solved next time with the factor of A by the Woodbury identity (one back-solve per
-  // added term instead of a new factorisation). clear() drops the terms.
-  void add_low_rank(const VecX& w, double k, const VecX& dg);
+  // added term instead of a new factorisation). clear() drops the terms. A term that also
+  // reaches the floating wall's y velocity (component w_wall) changes the wall's border instead
+  // of A there: b += k w_wall w, c += k w_wall^2, and its right-hand side by wall_rhs_change
+  // (the border stays outside the factor: one more back-solve for A^-1 b).
+  void add_low_rank(const VecX& w, double k, const VecX& dg, double w_wall = 0.0,
+                    double wall_rhs_change = 0.0);
   // Whether `more` terms on top of the pending ones are cheaper than a new factorisation:
   // each term costs one back-substitution (its column of A^-1 W is kept between solves).
   bool low_rank_pays(std::size_t more) const;
