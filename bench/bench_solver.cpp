@@ -27,6 +27,19 @@ struct Problem {
   Eigen::VectorXd rhs;
 };
 
+// The system a run of cfg assembles at its 30th step.
+template <class Sim>
+Problem assembled_after_30_steps(const sheardiff::Config& cfg) {
+  Sim sim(cfg);
+  for (int k = 0; k < 30; ++k) sim.step();
+  Problem p;
+  const auto& rs = sim.dynamics().force_balance().system();
+  p.lower = rs.matrix();
+  p.full = p.lower.selfadjointView<Eigen::Lower>();
+  p.rhs = rs.rhs();
+  return p;
+}
+
 const Problem& problem(int n) {
   static std::map<int, Problem> cache;
   auto it = cache.find(n);
@@ -36,14 +49,7 @@ const Problem& problem(int n) {
   cfg.particles.phi_init = 0.77;
   cfg.flow.j = 1e-2;
   cfg.contact.ktilde = 1e4;
-  sheardiff::Simulation sim(cfg);
-  for (int k = 0; k < 30; ++k) sim.step();
-  Problem p;
-  const auto& rs = sim.dynamics().force_balance().system();
-  p.lower = rs.matrix();
-  p.full = p.lower.selfadjointView<Eigen::Lower>();
-  p.rhs = rs.rhs();
-  return cache.emplace(n, std::move(p)).first->second;
+  return cache.emplace(n, assembled_after_30_steps<sheardiff::Simulation>(cfg)).first->second;
 }
 
 // Times factorisation + solve of an analysed solver and sets the counters every variant prints.
@@ -184,14 +190,7 @@ const Problem& problem_spheres(int n) {
   cfg.particles.phi_init_spheres = 0.55;
   cfg.flow.j = 1e-3;
   cfg.contact.ktilde = 1e4;
-  sheardiff::Simulation3 sim(cfg);
-  for (int k = 0; k < 30; ++k) sim.step();
-  Problem p;
-  const auto& rs = sim.dynamics().force_balance().system();
-  p.lower = rs.matrix();
-  p.full = p.lower.selfadjointView<Eigen::Lower>();
-  p.rhs = rs.rhs();
-  return cache.emplace(n, std::move(p)).first->second;
+  return cache.emplace(n, assembled_after_30_steps<sheardiff::Simulation3>(cfg)).first->second;
 }
 
 void cholmod_spheres(benchmark::State& state) {
