@@ -27,6 +27,7 @@ void ResistanceSystem::set_pattern(std::size_t n_mobile, const std::vector<PairO
   diagonal_only_ = diagonal_only;
   factor_of_a_ = false;
   lr_.clear();
+  a_inverse_b_updates_.clear();
   lr_z_cols_ = 0;
   lr_ready_ = false;
   const int d = dof_;
@@ -79,7 +80,8 @@ void ResistanceSystem::add_low_rank(const VecX& w, double k, const VecX& dg, dou
   if (w_wall != 0.0) {
     b_ += (k * w_wall) * w;
     c_ += k * w_wall * w_wall;
-    a_inverse_b_.resize(0);
+    if (a_inverse_b_.size() > 0)
+      a_inverse_b_updates_.emplace_back(static_cast<Eigen::Index>(lr_.size()), k * w_wall);
   }
   wall_rhs_ += wall_rhs_change;
   LowRankTerm t{{}, k};
@@ -110,6 +112,7 @@ bool ResistanceSystem::prepare() {
   ++factorisations_;
   factor_of_a_ = llt_->factorize(a_);
   a_inverse_b_.resize(0);
+  a_inverse_b_updates_.clear();
   return factor_of_a_;
 }
 
@@ -149,6 +152,7 @@ VecX ResistanceSystem::apply_inverse(const VecX& x, VecX* a_inverse_x) {
 void ResistanceSystem::clear() {
   factor_of_a_ = false;
   lr_.clear();
+  a_inverse_b_updates_.clear();
   lr_z_cols_ = 0;
   lr_ready_ = false;
   if (diagonal_only_)
@@ -261,7 +265,10 @@ bool ResistanceSystem::solve_with_floating_wall(VecX& u, double load, double fre
   } else {
     if (!prepare()) return false;
     u = apply_inverse(g_);
-    // A^-1 b of the factor is kept until a sticking pass changes the wall column.
+    // A^-1 b of the factor is kept; a sticking pass's change of the wall column is a sum of
+    // its terms' w, whose A^-1 w the Woodbury step above has just solved.
+    for (const auto& [term, coef] : a_inverse_b_updates_) a_inverse_b_ += coef * lr_z_.col(term);
+    a_inverse_b_updates_.clear();
     u1 = apply_inverse(b_, &a_inverse_b_);
   }
   // Schur complement of the bordered system [[A, b], [b^T, c]].

@@ -138,7 +138,7 @@ void tune_cholmod(cholmod_common& c, int dimension) {
   // -11 % per factorisation at N = 1000 and 4000 (bench/bench_solver, docs/performance.md); the
   // costlier analysis is paid once per neighbour rebuild. A packing of spheres has larger
   // separators, so its supernodes are large already: relaxing them further only adds zeros
-  // (7-13 % slower at N = 1000 and 2000, bench_solver's cholmod_spheres), so spheres keep
+  // (7-16 % slower at N = 1000, 9 % at 2000, bench_solver's cholmod_spheres), so spheres keep
   // CHOLMOD's relaxation.
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_NESDIS;

@@ -78,7 +78,8 @@ class ResistanceSystem final : public SystemEntries {
   // added term instead of a new factorisation). clear() drops the terms. A term that also
   // reaches the floating wall's y velocity (component w_wall) changes the wall's border instead
   // of A there: b += k w_wall w, c += k w_wall^2, and its right-hand side by wall_rhs_change
-  // (the border stays outside the factor: one more back-solve for A^-1 b).
+  // (the border stays outside the factor; A^-1 b follows from the term's column of A^-1 W, which
+  // the Woodbury solve computes anyway, so such a term costs no more than any other).
   void add_low_rank(const VecX& w, double k, const VecX& dg, double w_wall = 0.0,
                     double wall_rhs_change = 0.0);
   // Whether `more` terms on top of the pending ones are cheaper than a new factorisation:
@@ -90,6 +91,9 @@ class ResistanceSystem final : public SystemEntries {
 
   // Diagnostics: relative residual |A U + b V - g - m e| / |g + m e| of the last solve.
   double residual(const VecX& u, double v) const;
+  // The factorised A. After low-rank passes it lacks their pending terms k w w^T, while rhs()
+  // and the wall's border below include their changes: the system solved is then matrix() plus
+  // the terms (what residual() checks).
   const Eigen::SparseMatrix<double>& matrix() const { return a_; }
   const VecX& rhs() const { return g_; }
   // The floating wall's border of the system: column b, diagonal c and right-hand side
@@ -125,6 +129,9 @@ class ResistanceSystem final : public SystemEntries {
   // a_inverse_x: A^-1 x of the current factor if already solved (non-empty), else filled.
   VecX apply_inverse(const VecX& x, VecX* a_inverse_x = nullptr);
   VecX a_inverse_b_;  // A^-1 b of the current factor; empty until solved
+  // Changes of b by low-rank terms since A^-1 b was solved: b += coef * w of term `index`, so
+  // A^-1 b += coef * lr_z_.col(index) once the Woodbury columns are there.
+  std::vector<std::pair<Eigen::Index, double>> a_inverse_b_updates_;
 
   std::unique_ptr<SparseCholesky> llt_;
   std::size_t factorisations_ = 0, analyses_ = 0, low_rank_solves_ = 0, low_rank_terms_ = 0;
