@@ -127,6 +127,9 @@ def main():
                  f"channel cases over seeds: tools/channel_table.py reads those)")
     seed = fits["seed_table1"]
     dims = {r.get("dimension") for r in rows if r.get("dimension")}
+    if len(dims) > 1:
+        sys.exit(f"{out}: the store mixes discs and spheres (dimensions {sorted(dims)}); their "
+                 f"laws differ, so tabulate each from its own store")
     spheres = dims == {"3"}
     if only:
         if len(fits["groups"]) != 1:
@@ -135,7 +138,7 @@ def main():
         if only == "--laws":
             law_table(g["fits"], seed, dimension=3 if spheres else 2)
         elif only == "--every-j":
-            against_seed_laws(g["rows"], False)
+            against_seed_laws(g["rows"], False, dimension=3 if spheres else 2)
         elif only == "--means":
             means_table(g["rows"])
         else:
@@ -260,8 +263,9 @@ def against_seed_laws(rows, heading=True, dimension=2):
     """Per J: ours (mean over seeds +- sem), the seed's law there, and ours over the seed's."""
     if heading and dimension == 3:
         print("#### Every J against the seed's (2D) laws\n")
-        print("Spheres against the discs' laws: a 3D packing is not expected to follow the seed's "
-              "phi (its phi_c is that of discs); D, dv and Psi compare the two dimensions.\n")
+        print("Spheres against the discs' laws: D, dv and Psi compare the two dimensions. phi is "
+              "not compared here (the seed's phi_c is that of discs): see Boyer et al.'s "
+              "phi(J) below.\n")
     elif heading:
         print("#### Every J against the seed's laws\n")
         print("Ours: mean over seeds +- standard error from their scatter; seed: its Table 1 law "
@@ -278,7 +282,9 @@ def against_seed_laws(rows, heading=True, dimension=2):
             if x is None:
                 cells += ["-", fmt(ref, p), "-"]
                 continue
-            if q == "phi":
+            if q == "phi" and dimension == 3:
+                cells += [pm(x, e, 4), "-", "-"]
+            elif q == "phi":
                 cells += [pm(x, e, 4), f"{ref:.4f}", f"{x - ref:+.4f}"]
             else:
                 cells += [pm(x, e, 3), f"{ref:.3g}",
