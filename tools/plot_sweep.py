@@ -220,6 +220,12 @@ def main():
                 ax[7].loglog(phic - num(r, "phi"), num(r, "dv") * num(r, "psi"), "o",
                              color=colours[0], mfc="none", ms=5)
     ax[9].axhline(1.0, color="k", lw=0.8)
+    if phic is None:
+        # Without a fitted phi_c the points have no abscissa here: say why the panel is empty.
+        why = next((g["fits"]["phi_of_J"].get("error") for g in fits["groups"]), None)
+        for a_ in (ax[4], ax[6], ax[7]):
+            a_.text(0.5, 0.5, "no points: phi_c not fitted\n" + (why or ""), ha="center",
+                    va="center", fontsize=7, transform=a_.transAxes, wrap=True)
 
     jg = np.logspace(-4, -1, 40)
     a, b = SEED["D"]
