@@ -139,18 +139,15 @@ BENCHMARK(sheardiff_cholmod)->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kM
 // does) or as one k-column block on the tuned supernodal factor. Compare time per column with
 // cholmod_supernodal_tuned's factorisation: that ratio bounds the budget of low_rank_pays
 // (docs/performance.md, "Block columns for the sticking re-solve": measured not to pay in runs).
-template <bool Block>
-void cholmod_low_rank_columns(benchmark::State& state) {
-  const Problem& p = problem(static_cast<int>(state.range(0)));
-  const auto k = static_cast<Eigen::Index>(state.range(1));
-  Supernodal solver;
-  sheardiff::tune_cholmod(solver.cholmod());
-  solver.analyzePattern(p.lower);
-  solver.factorize(p.lower);
-  const Eigen::Index n = p.lower.rows();
+// k columns of nnz non-zeros each (a pair's slip mode) solved one by one or as one block on a
+// factorised solver; the time per column as a counter.
+template <bool Block, class Solver>
+void time_columns(benchmark::State& state, const Solver& solver, Eigen::Index n, Eigen::Index k,
+                  Eigen::Index nnz) {
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(n, k);
   for (Eigen::Index c = 0; c < k; ++c)
-    for (Eigen::Index r = 0; r < 6; ++r) w((c * 97 + r * (n / 7)) % n, c) = 1.0 / (1.0 + r);
+    for (Eigen::Index r = 0; r < nnz; ++r)
+      w((c * 97 + r * (n / (nnz + 1))) % n, c) = 1.0 / (1.0 + r);
   Eigen::MatrixXd z(n, k);
   for (auto _ : state) {
     if (Block) {
@@ -163,6 +160,16 @@ void cholmod_low_rank_columns(benchmark::State& state) {
   state.counters["us_per_column"] = benchmark::Counter(
       static_cast<double>(k) * 1e-6,
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+template <bool Block>
+void cholmod_low_rank_columns(benchmark::State& state) {
+  const Problem& p = problem(static_cast<int>(state.range(0)));
+  Supernodal solver;
+  sheardiff::tune_cholmod(solver.cholmod());
+  solver.analyzePattern(p.lower);
+  solver.factorize(p.lower);
+  time_columns<Block>(state, solver, p.lower.rows(), state.range(1), 6);
 }
 BENCHMARK(cholmod_low_rank_columns<false>)
     ->Name("cholmod_columns_one_by_one")
@@ -210,6 +217,32 @@ void cholmod_spheres(benchmark::State& state) {
 }
 BENCHMARK(cholmod_spheres)
     ->ArgsProduct({{500, 1000, 2000}, {0, 1, 2}, {0, 2, 5, 10, 20}})
+    ->Unit(benchmark::kMillisecond);
+
+// The Woodbury columns of spheres (12 non-zeros each: a pair's tangential rows), one by one
+// and as one block, on the spheres' tuned factor of cholmod_spheres' matrix, with the back-solves
+// a factorisation costs (solves_per_factorisation, as low_rank_pays reads it). At J = 1e-3 and
+// N = 1000 a step switches ~170 contacts, two columns each: the re-solve pays on the old factor
+// only if that many columns cost less than a factorisation (docs/performance.md "Spheres").
+template <bool Block>
+void cholmod_spheres_columns(benchmark::State& state) {
+  const Problem& p = problem_spheres(static_cast<int>(state.range(0)));
+  Supernodal solver;
+  sheardiff::tune_cholmod(solver.cholmod(), 3);
+  solver.analyzePattern(p.lower);
+  solver.factorize(p.lower);
+  time_columns<Block>(state, solver, p.lower.rows(), state.range(1), 12);
+  auto ours = sheardiff::make_sparse_cholesky("cholmod", 3);
+  ours->analyze(p.lower);
+  state.counters["solves_per_factorisation"] = ours->solves_per_factorisation();
+}
+BENCHMARK(cholmod_spheres_columns<false>)
+    ->Name("cholmod_spheres_columns_one_by_one")
+    ->ArgsProduct({{1000}, {1, 32, 340}})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(cholmod_spheres_columns<true>)
+    ->Name("cholmod_spheres_columns_block")
+    ->ArgsProduct({{1000}, {1, 32, 340}})
     ->Unit(benchmark::kMillisecond);
 
 using CholSimplicial = Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
