@@ -88,7 +88,7 @@ BENCHMARK(factorise<LDLT>)
     ->Arg(4000)
     ->Unit(benchmark::kMillisecond);
 #ifdef SHEARDIFF_HAVE_CHOLMOD
-using Supernodal = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+using sheardiff::Supernodal;
 
 // CHOLMOD supernodal with CHOLMOD's defaults (AMD; named cholmod_supernodal_llt in the first
 // solver table of docs/performance.md) or with sheardiff's settings

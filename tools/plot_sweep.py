@@ -24,7 +24,6 @@ as the 2D reference ("2D seed").
     /usr/bin/python3 tools/plot_sweep.py DIR [--out DIR/sweep.png]
 """
 import argparse
-import csv
 import json
 import math
 import pathlib
@@ -88,13 +87,10 @@ def main():
         print("warning: no h5py: the MSD panels are left empty", file=sys.stderr)
 
     fits = json.loads((args.sweep / "fits.json").read_text())
-    table = list(csv.DictReader(open(args.sweep / "sweep.csv")))
-    # The points the fits used: a fit with --include-not-stationary used the flagged ones too.
-    flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
-    rows = [r for r in table if r["status"] == "done"
-            or (fits.get("includes_not_stationary") and r["status"] in flagged)]
-    dims = {int(num(r, "dimension")) for r in table
-            if r["status"].startswith("done") and math.isfinite(num(r, "dimension"))}
+    store = rundir.Store(args.sweep)
+    rows = store.fitted_rows()
+    dims = {int(num(r, "dimension")) for r in store.rows(done=True)
+            if math.isfinite(num(r, "dimension"))}
     if len(dims) > 1:
         sys.exit(f"{args.sweep}: discs and spheres in one table; plot them apart")
     dim = dims.pop() if dims else 2

@@ -131,14 +131,15 @@ def main():
         sys.exit(f"{out}: the store mixes discs and spheres (dimensions {sorted(dims)}); their "
                  f"laws differ, so tabulate each from its own store")
     spheres = dims == {"3"}
+    dimension = 3 if spheres else 2
     if only:
         if len(fits["groups"]) != 1:
             sys.exit(f"{out}: {only} needs one group of points, not {len(fits['groups'])}")
         g = fits["groups"][0]
         if only == "--laws":
-            law_table(g["fits"], seed, dimension=3 if spheres else 2)
+            law_table(g["fits"], seed, dimension=dimension)
         elif only == "--every-j":
-            against_seed_laws(g["rows"], False, dimension=3 if spheres else 2)
+            against_seed_laws(g["rows"], False, dimension=dimension)
         elif only == "--means":
             means_table(g["rows"])
         else:
@@ -146,9 +147,7 @@ def main():
         return
     # Measurements that enter the fits; every finished run counts for the cost.
     # (`sheardiff fit --include-not-stationary` fits the flagged windows too: so does this.)
-    flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
-    done = [r for r in rows if r["status"] == "done"
-            or (fits.get("includes_not_stationary") and r["status"] in flagged)]
+    done = store.fitted_rows()
     finished = [r for r in rows if r["status"].startswith("done")]
     cpu = sum(float(r["wall_seconds"]) for r in finished if r.get("wall_seconds"))
     print(f"{fits['finished']} of {fits['points']} points finished; summed run time "
@@ -160,9 +159,9 @@ def main():
               "scatter); [the runs' own error bars, rms / sqrt(n)].\n")
         means_table(g["rows"])
         print()
-        law_table(g["fits"], seed, dimension=3 if spheres else 2)
+        law_table(g["fits"], seed, dimension=dimension)
         print()
-        against_seed_laws(g["rows"], dimension=3 if spheres else 2)
+        against_seed_laws(g["rows"], dimension=dimension)
         if spheres:
             against_boyer(g["rows"])
     causes(done)

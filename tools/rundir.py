@@ -140,6 +140,14 @@ class Store:
             rows = list(csv.DictReader(f))
         return [r for r in rows if r["status"].startswith("done")] if done else rows
 
+    def fitted_rows(self):
+        """The rows whose measurements the fits used: the stationary ones, and the flagged ones
+        too when the fit was made with `sheardiff fit --include-not-stationary`."""
+        flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
+        with_flagged = self.fits.get("includes_not_stationary")
+        return [r for r in self.rows()
+                if r["status"] == "done" or (with_flagged and r["status"] in flagged)]
+
     @property
     def fits(self):
         return read_json(self.path / FITS)

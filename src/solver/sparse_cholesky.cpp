@@ -34,14 +34,6 @@ class EigenBacked final : public SparseCholesky {
   const char* name_;
 };
 
-using Supernodal = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-
-// Eigen's wrapper with the factor in reach (its permutation).
-class SupernodalWithFactor : public Supernodal {
- public:
-  const cholmod_factor* factor() const { return m_cholmodFactor; }
-};
-
 // CHOLMOD factorises tril(P A P^T). Given the lower triangle of A and a fill-reducing P, it
 // forms that matrix with two symmetric transposes before every factorisation
 // (cholmod_transpose_sym: 7-10 % of a run's time in perf). Here the ordering is computed once

@@ -47,12 +47,6 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermuting) {
   }
 }
 
-// Eigen's wrapper with CHOLMOD's symbolic factor in reach.
-class WithFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
- public:
-  const cholmod_factor* factor() const { return m_cholmodFactor; }
-};
-
 // Spheres: their own tuning (CHOLMOD's supernode relaxation), the same two paths.
 TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
   Config cfg;
@@ -79,7 +73,7 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
   // The discs' tuning partitions the same matrix into fewer, larger supernodes (more explicit
   // zeros): the spheres' tuning is a different factorisation, not a relabelled one. Read from
   // the symbolic factors, which do not depend on the BLAS's rounding.
-  WithFactor spheres, discs;
+  SupernodalWithFactor spheres, discs;
   tune_cholmod(spheres.cholmod(), 3);
   tune_cholmod(discs.cholmod(), 2);
   spheres.analyzePattern(a);

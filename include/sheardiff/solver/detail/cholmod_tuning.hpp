@@ -3,7 +3,17 @@
 // (src/solver/sparse_cholesky.cpp), its tests and the solver benchmark include this.
 #include <cholmod.h>
 
+#include <Eigen/CholmodSupport>
+
 namespace sheardiff {
+
+using Supernodal = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+
+// Eigen's wrapper with CHOLMOD's factor in reach (its permutation, its supernodes).
+class SupernodalWithFactor : public Supernodal {
+ public:
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+};
 
 // The ordering and supernode settings sheardiff uses for CHOLMOD on the matrix of discs
 // (dimension 2) or spheres (3) (measured, see src/solver/sparse_cholesky.cpp).
