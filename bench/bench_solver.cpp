@@ -135,10 +135,11 @@ void sheardiff_cholmod(benchmark::State& state) {
 BENCHMARK(sheardiff_cholmod)->Arg(250)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond);
 
 // Back-substitutions of the low-rank sticking re-solve (ResistanceSystem::apply_inverse): k
-// columns, each the slip mode of one contact (6 non-zeros), solved one by one (as sheardiff
-// does) or as one k-column block on the tuned supernodal factor. Compare time per column with
+// columns, each the slip mode of one contact (6 non-zeros), solved one by one or as one k-column
+// block (as sheardiff does) on the tuned supernodal factor. Compare time per column with
 // cholmod_supernodal_tuned's factorisation: that ratio bounds the budget of low_rank_pays
-// (docs/performance.md, "Block columns for the sticking re-solve": measured not to pay in runs).
+// (docs/performance.md, "Block columns for the sticking re-solve": a larger budget was measured
+// not to pay in runs).
 // k columns of nnz non-zeros each (a pair's slip mode) solved one by one or as one block on a
 // factorised solver; the time per column as a counter.
 template <bool Block, class Solver>

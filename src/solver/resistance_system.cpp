@@ -126,14 +126,15 @@ VecX ResistanceSystem::apply_inverse(const VecX& x, VecX* a_inverse_x) {
   }
   if (lr_.empty()) return y;
   // Woodbury: (A + W K W^T)^-1 = A^-1 - Z (K^-1 + W^T Z)^-1 Z^T, Z = A^-1 W. The columns of Z
-  // of earlier passes are kept: a pass costs one back-substitution per new term.
+  // of earlier passes are kept: a pass solves its new terms' columns, as one block.
   const auto r = static_cast<Eigen::Index>(lr_.size());
   if (!lr_ready_) {
     lr_z_.conservativeResize(x.size(), r);
-    for (Eigen::Index c = lr_z_cols_; c < r; ++c) {
-      VecX w = VecX::Zero(x.size());
-      for (const auto& [i, v] : lr_[c].w) w[i] = v;
-      lr_z_.col(c) = llt_->solve(w);
+    if (r > lr_z_cols_) {
+      Eigen::MatrixXd w = Eigen::MatrixXd::Zero(x.size(), r - lr_z_cols_);
+      for (Eigen::Index c = lr_z_cols_; c < r; ++c)
+        for (const auto& [i, v] : lr_[c].w) w(i, c - lr_z_cols_) = v;
+      lr_z_.rightCols(r - lr_z_cols_) = llt_->solve(w);
     }
     lr_z_cols_ = r;
     Eigen::MatrixXd s(r, r);

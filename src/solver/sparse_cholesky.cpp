@@ -27,6 +27,7 @@ class EigenBacked final : public SparseCholesky {
     return solver_.info() == Eigen::Success;
   }
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override { return solver_.solve(rhs); }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override { return solver_.solve(rhs); }
   const char* name() const override { return name_; }
 
  protected:
@@ -107,6 +108,13 @@ class Cholmod final : public SparseCholesky {
     for (Eigen::Index k = 0; k < rhs.size(); ++k) x[k] = rhs[perm_[k]];
     const Eigen::VectorXd y = natural_.solve(x);
     for (Eigen::Index k = 0; k < rhs.size(); ++k) x[perm_[k]] = y[k];
+    return x;
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override {
+    Eigen::MatrixXd x(rhs.rows(), rhs.cols());
+    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(k) = rhs.row(perm_[k]);
+    const Eigen::MatrixXd y = natural_.solve(x);
+    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(perm_[k]) = y.row(k);
     return x;
   }
   const char* name() const override { return "cholmod"; }

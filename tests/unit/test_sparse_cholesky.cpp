@@ -83,5 +83,43 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
   EXPECT_GT(discs.factor()->xsize, spheres.factor()->xsize);
 }
 
+// The Woodbury columns of a sticking re-solve are solved as one block: each column of the
+// block is the solution of that column alone, for both back-ends. The block kernels may round
+// differently from the one-column ones, hence a relative tolerance (1e-10: far above the
+// round-off, far below the O(1) error of a misplaced permutation or column).
+TEST(SparseCholesky, BlockSolveIsTheColumnsSolvedOneByOne) {
+  Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.scene.dimension = 3;
+  cfg.particles.n = 150;
+  cfg.particles.phi_init_spheres = 0.5;
+  cfg.flow.j = 1e-2;
+  cfg.contact.ktilde = 1e4;
+  Simulation3 sim(cfg);
+  for (int k = 0; k < 10; ++k) sim.step();
+  const auto& a = sim.dynamics().force_balance().system().matrix();
+  const Eigen::Index n = a.rows(), k = 7;
+  // Sparse columns like a contact's tangential rows, and one dense column.
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(n, k);
+  for (Eigen::Index c = 0; c + 1 < k; ++c)
+    for (Eigen::Index r = 0; r < 12; ++r) w((c * 97 + r * 31) % n, c) = 1.0 / (1.0 + r);
+  w.col(k - 1) = sim.dynamics().force_balance().system().rhs();
+  for (const char* kind : {"cholmod", "eigen"}) {
+    auto chol = make_sparse_cholesky(kind, 3);
+    chol->analyze(a);
+    ASSERT_TRUE(chol->factorize(a));
+    const Eigen::MatrixXd z = chol->solve(w);
+    ASSERT_EQ(z.rows(), n);
+    ASSERT_EQ(z.cols(), k);
+    for (Eigen::Index c = 0; c < k; ++c) {
+      const Eigen::VectorXd one = chol->solve(Eigen::VectorXd(w.col(c)));
+      EXPECT_LE((z.col(c) - one).norm(), 1e-10 * one.norm()) << kind << " column " << c;
+      // And it solves A z = w (the permutation is undone row by row).
+      const Eigen::VectorXd az = a.selfadjointView<Eigen::Lower>() * z.col(c);
+      EXPECT_LE((az - w.col(c)).norm(), 1e-8 * w.col(c).norm()) << kind << " column " << c;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sheardiff

@@ -82,8 +82,11 @@ class ResistanceSystem final : public SystemEntries {
   // the Woodbury solve computes anyway, so such a term costs no more than any other).
   void add_low_rank(const VecX& w, double k, const VecX& dg, double w_wall = 0.0,
                     double wall_rhs_change = 0.0);
-  // Whether `more` terms on top of the pending ones are cheaper than a new factorisation:
-  // each term costs one back-substitution (its column of A^-1 W is kept between solves).
+  // Whether `more` terms on top of the pending ones are cheaper than a new factorisation,
+  // counting one back-substitution a term (its column of A^-1 W is kept between solves). A
+  // pass solves its terms' columns as one block, which costs less (2.5-4x for spheres): the
+  // budget errs towards refactorising, and a larger one for spheres was not faster in runs
+  // (docs/performance.md "Spheres").
   bool low_rank_pays(std::size_t more) const;
   void set_max_low_rank_terms(std::size_t n) { max_low_rank_terms_ = n; }
   std::size_t low_rank_solves() const { return low_rank_solves_; }
