@@ -47,8 +47,12 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermuting) {
   }
 }
 
-// Spheres: their own tuning (CHOLMOD's supernode relaxation), the same two paths.
-TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
+// The matrix and right-hand side of 150 spheres in the pressure cell after 10 steps.
+struct SpheresSystem {
+  Eigen::SparseMatrix<double> a;
+  Eigen::VectorXd rhs;
+};
+SpheresSystem sheared_spheres() {
   Config cfg;
   cfg.scene.type = "pressure_shear";
   cfg.scene.dimension = 3;
@@ -58,8 +62,13 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
   cfg.contact.ktilde = 1e4;
   Simulation3 sim(cfg);
   for (int k = 0; k < 10; ++k) sim.step();
-  const auto& a = sim.dynamics().force_balance().system().matrix();
-  const Eigen::VectorXd rhs = sim.dynamics().force_balance().system().rhs();
+  const auto& system = sim.dynamics().force_balance().system();
+  return {system.matrix(), system.rhs()};
+}
+
+// Spheres: their own tuning (CHOLMOD's supernode relaxation), the same two paths.
+TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
+  const auto [a, rhs] = sheared_spheres();
   ASSERT_GT(a.nonZeros(), 6 * a.rows()) << "the test needs coupled spheres";
 
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> reference;
@@ -88,22 +97,13 @@ TEST(SparseCholesky, PrePermutedSameAsCholmodPermutingForSpheres) {
 // differently from the one-column ones, hence a relative tolerance (1e-10: far above the
 // round-off, far below the O(1) error of a misplaced permutation or column).
 TEST(SparseCholesky, BlockSolveIsTheColumnsSolvedOneByOne) {
-  Config cfg;
-  cfg.scene.type = "pressure_shear";
-  cfg.scene.dimension = 3;
-  cfg.particles.n = 150;
-  cfg.particles.phi_init_spheres = 0.5;
-  cfg.flow.j = 1e-2;
-  cfg.contact.ktilde = 1e4;
-  Simulation3 sim(cfg);
-  for (int k = 0; k < 10; ++k) sim.step();
-  const auto& a = sim.dynamics().force_balance().system().matrix();
+  const auto [a, rhs] = sheared_spheres();
   const Eigen::Index n = a.rows(), k = 7;
   // Sparse columns like a contact's tangential rows, and one dense column.
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(n, k);
   for (Eigen::Index c = 0; c + 1 < k; ++c)
     for (Eigen::Index r = 0; r < 12; ++r) w((c * 97 + r * 31) % n, c) = 1.0 / (1.0 + r);
-  w.col(k - 1) = sim.dynamics().force_balance().system().rhs();
+  w.col(k - 1) = rhs;
   for (const char* kind : {"cholmod", "eigen"}) {
     auto chol = make_sparse_cholesky(kind, 3);
     chol->analyze(a);
