@@ -130,11 +130,11 @@ VecX ResistanceSystem::apply_inverse(const VecX& x, VecX* a_inverse_x) {
   const auto r = static_cast<Eigen::Index>(lr_.size());
   if (!lr_ready_) {
     lr_z_.conservativeResize(x.size(), r);
-    if (r > lr_z_cols_) {
-      Eigen::MatrixXd w = Eigen::MatrixXd::Zero(x.size(), r - lr_z_cols_);
-      for (Eigen::Index c = lr_z_cols_; c < r; ++c)
-        for (const auto& [i, v] : lr_[c].w) w(i, c - lr_z_cols_) = v;
-      lr_z_.rightCols(r - lr_z_cols_) = llt_->solve(w);
+    if (const Eigen::Index fresh = r - lr_z_cols_; fresh > 0) {
+      Eigen::MatrixXd w = Eigen::MatrixXd::Zero(x.size(), fresh);
+      for (Eigen::Index c = 0; c < fresh; ++c)
+        for (const auto& [i, v] : lr_[lr_z_cols_ + c].w) w(i, c) = v;
+      lr_z_.rightCols(fresh) = llt_->solve(w);
     }
     lr_z_cols_ = r;
     Eigen::MatrixXd s(r, r);

@@ -103,24 +103,22 @@ class Cholmod final : public SparseCholesky {
     natural_.factorize(permuted_);
     return natural_.info() == Eigen::Success;
   }
-  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override {
-    Eigen::VectorXd x(rhs.size());
-    for (Eigen::Index k = 0; k < rhs.size(); ++k) x[k] = rhs[perm_[k]];
-    const Eigen::VectorXd y = natural_.solve(x);
-    for (Eigen::Index k = 0; k < rhs.size(); ++k) x[perm_[k]] = y[k];
-    return x;
-  }
-  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override {
-    Eigen::MatrixXd x(rhs.rows(), rhs.cols());
-    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(k) = rhs.row(perm_[k]);
-    const Eigen::MatrixXd y = natural_.solve(x);
-    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(perm_[k]) = y.row(k);
-    return x;
-  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override { return permuted_solve(rhs); }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override { return permuted_solve(rhs); }
   const char* name() const override { return "cholmod"; }
   double solves_per_factorisation() const override { return solves_per_factorisation_; }
 
  private:
+  // P A P^T (P x) = P b: the rows of the right-hand sides in, the solution's rows back.
+  template <class Dense>
+  Dense permuted_solve(const Dense& rhs) const {
+    Dense x(rhs.rows(), rhs.cols());
+    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(k) = rhs.row(perm_[k]);
+    const Dense y = natural_.solve(x);
+    for (Eigen::Index k = 0; k < rhs.rows(); ++k) x.row(perm_[k]) = y.row(k);
+    return x;
+  }
+
   SupernodalWithFactor ordering_;  // analysis only: the fill-reducing P
   Supernodal natural_;             // factorises tril(P A P^T) as given
   Eigen::VectorXi perm_;           // P: row k of P A P^T is row perm_[k] of A

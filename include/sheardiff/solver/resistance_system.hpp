@@ -84,7 +84,7 @@ class ResistanceSystem final : public SystemEntries {
                     double wall_rhs_change = 0.0);
   // Whether `more` terms on top of the pending ones are cheaper than a new factorisation,
   // counting one back-substitution a term (its column of A^-1 W is kept between solves). A
-  // pass solves its terms' columns as one block, which costs less (2.5-4x for spheres): the
+  // pass solves its terms' columns as one block, which costs less (3-6x for spheres): the
   // budget errs towards refactorising, and a larger one for spheres was not faster in runs
   // (docs/performance.md "Spheres").
   bool low_rank_pays(std::size_t more) const;
