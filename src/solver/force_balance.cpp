@@ -134,15 +134,24 @@ bool ForceBalanceOf<D>::solve(const Particles& p, const Box& box, const ImposedF
 }
 
 template <class D>
-std::vector<typename D::PairVector> ForceBalanceOf<D>::slip_rows(const PairGeometryOf<D>& g) {
+auto ForceBalanceOf<D>::slip_rows(const PairGeometryOf<D>& g, const PairHistoryOf<D>& h) const
+    -> std::vector<SlipRow> {
   if constexpr (D::space == 2) {
-    return {FrictionalContact::slip_mode(g)};
+    (void)h;
+    return {{FrictionalContact::slip_mode(g), 1.0}};
   } else {
     // W^T W = sum over an orthonormal basis t_a of the tangent plane of (t_a^T W)^T (t_a^T W):
-    // W maps into that plane, and two rows carry it all.
-    const Space3 t1 = g.n.unitOrthogonal(), t2 = g.n.cross(t1);
+    // W maps into that plane, and two rows carry it all. Along and across the stretch when the
+    // sliding spring already has its share across it.
     const FrictionalContact::SlipMode3 w = FrictionalContact::slip_mode_3d(g);
-    return {(t1.transpose() * w).transpose(), (t2.transpose() * w).transpose()};
+    const Space3& xi = h.contact.xi;
+    const bool sideways = contact().sideways && xi.squaredNorm() > 0.0;
+    const Space3 t1 = sideways ? Space3(xi.normalized()) : Space3(g.n.unitOrthogonal());
+    const Space3 t2 = g.n.cross(t1);
+    std::vector<SlipRow> rows{{(t1.transpose() * w).transpose(), 1.0}};
+    const double across = sideways ? 1.0 - h.contact.across : 1.0;
+    if (across > 0.0) rows.push_back({(t2.transpose() * w).transpose(), across});
+    return rows;
   }
 }
 
@@ -155,8 +164,9 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
                                               Velocities& out) {
   // A fresh assembly reads the contacts' new state when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
-  constexpr std::size_t kRows = D::space == 2 ? 1 : 2;
-  const bool over_budget = !system_.low_rank_pays(kRows * switched.size());
+  std::size_t rows = 0;
+  for (std::size_t k : switched) rows += slip_rows(terms_[k].g, pairs[k].history).size();
+  const bool over_budget = !system_.low_rank_pays(rows);
   sticking_.switched += static_cast<long>(switched.size());
   if (over_budget) {
     ++sticking_.refactorised_budget;
@@ -169,7 +179,7 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
   for (std::size_t k : switched) {
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
-    const double kt = dt_implicit * contact().kt_of(term.g);
+    const double kt_full = dt_implicit * contact().kt_of(term.g);
     const Motion mj = p.motion[pr.j];
     const bool j_mobile = mj == Motion::Mobile, j_floating = mj == Motion::FloatingWall;
     // Known velocity of j's side: the Lees-Edwards image's, the top wall's driven x velocity
@@ -178,7 +188,8 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
                            : j_floating || mj == Motion::DrivenWall ? walls->driven_vx
                                                                     : 0.0;
     term.sliding = false;
-    for (const auto& row : slip_rows(term.g)) {
+    for (const auto& [row, share] : slip_rows(term.g, pr.history)) {
+      const double kt = share * kt_full;
       // The pair term as a new assembly would make it (stresses read it after the step).
       term.m += kt * row * row.transpose();
       w.setZero(static_cast<Eigen::Index>(system_.unknowns()));

@@ -1,13 +1,16 @@
 // Stepping spheres (Dynamics3 and the integrators instantiated in three dimensions): a sphere
-// pressed on a wall sphere settles at the overlap F / kn; spheres whose centres lie in one plane
+// pressed on a wall sphere settles at the overlap F / kn; a sphere sliding on one turns its
+// friction with a turned load; spheres whose centres lie in one plane
 // step exactly as the discs of the same configuration; and in a pressure cell of spheres between
 // rough walls of frozen spheres, the suspension pushes on the floating top wall with exactly
 // P Lx Lz at every step once the wall rests on it.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -81,21 +84,114 @@ TEST(SphereDynamics, SpherePressedOnAWallSphereSettlesAtTheOverlapFOverKn) {
   }
 }
 
+// A sphere sliding on a wall sphere under a tangential load 1.5 times the Coulomb cap, at a
+// large implicit step (tens of caps of slip a step), after the load turns by 30 degrees in the
+// tangent plane. The law (continuous in time): the friction force turns with the slip, within a
+// fraction of a step here, to lie against the load. The load direction is carried with the pair
+// as the spring is (projected on the new tangent plane), so the target does not move. The first
+// step after the turn brings the force within ~0.01 rad of the load either way. With
+// contact.sliding_stiffness = "sideways" the rest goes by a factor ~30 a step, to round-off
+// within ten steps, and the contact ends every step sliding. With "none" the direction is explicit:
+// each step turns it to the last step's slip, and with a load below twice the cap that
+// correction overshoots, 7-10 times the error, until the slip reverses and the contact sticks;
+// it cycles so (three steps, up to 0.94 rad) and never settles.
+struct TurnedLoadRun {
+  std::vector<double> angle;  // signed angle of -xi from the load about n, after each step
+  long stuck = 0;             // contacts switched to sticking after the turn
+  int sliding_steps = 0;      // steps after the turn that ended sliding
+};
+
+TurnedLoadRun slide_with_turned_load(const std::string& sliding_stiffness) {
+  Config cfg;
+  cfg.contact.ktilde = 1e4;
+  cfg.contact.sliding_stiffness = sliding_stiffness;
+  cfg.integrator.dt = 0.1;
+  cfg.neighbour.skin = 1.0;  // no rebuild: the pair's history is read after each step
+  const double a = 0.5, fn = 2.0, ft = 1.5 * cfg.contact.mu * fn;
+  Particles3 p;
+  p.resize(2);
+  p.n_mobile = 1;
+  p.position = {Space3(4.0, 4.0, 4.0), Space3(4.0, 5.0 - fn / cfg.contact.ktilde, 4.0)};
+  p.unwrapped = p.position;
+  p.radius = {a, a};
+  p.motion[1] = Motion::FixedWall;
+  Box3 box;
+  box.lx = box.ly = box.lz = 8.0;
+  WallBodies walls;
+  walls.bottom = {1};
+  walls.top_role = WallRole::Fixed;
+  Dynamics3 d = make_dynamics(cfg, p, box, ImposedFlow{0.0, 0.0}, walls, true);
+  auto integrator = make_integrator_of<Dim3>(IntegratorType::Implicit);
+  Space3 load = Space3::UnitX();
+  TurnedLoadRun run;
+  for (int s = 0; s < 40; ++s) {
+    const Space3 r = d.particles().position[1] - d.particles().position[0];
+    const Space3 n = r.normalized();
+    if (s == 10) load = Eigen::AngleAxisd(kPi / 6.0, n) * load;  // the turn
+    load = (load - load.dot(n) * n).normalized();                // carried with the pair
+    Vec6 push = Vec6::Zero();
+    push.head<3>() = fn * n + ft * load;
+    d.particles_mut().external = {push, Vec6::Zero()};
+    const long stuck_before = d.force_balance().sticking_counts().switched;
+    EXPECT_TRUE(integrator->step(d));
+    const auto& pairs = d.neighbours().pairs();
+    EXPECT_EQ(pairs.size(), 1u);
+    EXPECT_TRUE(pairs[0].history.touching) << "step " << s;
+    if (s < 10) continue;
+    const auto& spring = pairs[0].history.contact;
+    run.stuck += d.force_balance().sticking_counts().switched - stuck_before;
+    run.sliding_steps += spring.sliding ? 1 : 0;
+    const Space3 n_end = (d.particles().position[1] - d.particles().position[0]).normalized();
+    const Space3 f = -spring.xi.normalized();
+    const Space3 l = (load - load.dot(n_end) * n_end).normalized();
+    run.angle.push_back(std::atan2(l.cross(f).dot(n_end), l.dot(f)));
+  }
+  return run;
+}
+
+TEST(SphereDynamics, SlidingSphereFrictionTurnsWithItsLoad) {
+  const TurnedLoadRun sideways = slide_with_turned_load("sideways");
+  ASSERT_EQ(sideways.angle.size(), 30u);
+  ASSERT_GT(std::abs(sideways.angle[0]), 1e-3) << "the turn is not seen";
+  // Round-off of a direction is 1e-15 rad; 1e-12 is far below the first steps' errors.
+  for (std::size_t k = 10; k < sideways.angle.size(); ++k)
+    EXPECT_LT(std::abs(sideways.angle[k]), 1e-12) << "step " << k << " after the turn";
+  // The step that sticks the contact once (its slip turned back) still narrows the angle; from
+  // there it shrinks by more than 10x a step (25-40x here).
+  EXPECT_LT(std::abs(sideways.angle[1]), std::abs(sideways.angle[0]));
+  for (std::size_t k = 2; k < 10; ++k)
+    EXPECT_LT(std::abs(sideways.angle[k]), 0.1 * std::abs(sideways.angle[k - 1]) + 1e-14)
+        << "step " << k << " after the turn";
+  EXPECT_LE(sideways.stuck, 1);
+  EXPECT_EQ(sideways.sliding_steps, 30);
+
+  const TurnedLoadRun none = slide_with_turned_load("none");
+  double late = 0.0;
+  for (std::size_t k = 15; k < none.angle.size(); ++k)
+    late = std::max(late, std::abs(none.angle[k]));
+  EXPECT_GT(late, 0.5) << "the explicit direction settled";
+  EXPECT_GE(none.stuck, 5) << "the explicit direction did not reverse the slip";
+}
+
 using testing_3d::lift;
 
 TEST(SphereDynamics, SpheresInOnePlaneStepAsTheDiscs) {
   // Forty implicit steps of a sheared dense packing from its start (no contact history yet) in
   // two and three dimensions: the same step sizes and, to round-off grown over the steps, the
   // same positions, contacts opening and springs loading alike; the spheres never leave their
-  // plane. With either stick rule (contact.stick_rule): in the plane they are one test.
-  for (const char* rule : {"unloading", "coulomb"}) {
-    SCOPED_TRACE(rule);
+  // plane. With either stick rule (contact.stick_rule): in the plane they are one test. And with
+  // either stiffness of sliding spheres (contact.sliding_stiffness): across a stretch in the
+  // plane is out of it, where nothing moves.
+  for (const auto& [rule, sliding] : {std::pair{"unloading", "none"}, std::pair{"coulomb", "none"},
+                                      std::pair{"unloading", "sideways"}}) {
+    SCOPED_TRACE(std::string(rule) + ", " + sliding);
     Config cfg;
     cfg.particles.n = 200;
     cfg.particles.phi_init = 0.78;
     cfg.flow.j = 1e-2;
     cfg.contact.ktilde = 1e4;
     cfg.contact.stick_rule = rule;
+    cfg.contact.sliding_stiffness = sliding;
     Simulation sim(cfg);
     Dynamics& d2 = sim.dynamics();
     const double lz = 40.0;
@@ -141,14 +237,15 @@ struct SphereCell {
   Dynamics3 dynamics;
   std::unique_ptr<IntegratorOf<Dim3>> integrator;
 
-  explicit SphereCell(std::int64_t seed)
-      : cfg(cell_config(seed)),
+  explicit SphereCell(std::int64_t seed, const std::string& sliding_stiffness = "none")
+      : cfg(cell_config(seed, sliding_stiffness)),
         scene(build_pressure_shear_3d(cfg)),
         dynamics(make_dynamics(cfg, scene.particles, scene.box, scene.flow, scene.walls, true)),
         integrator(make_integrator_of<Dim3>(IntegratorType::Implicit)) {}
 
-  static Config cell_config(std::int64_t seed) {
+  static Config cell_config(std::int64_t seed, const std::string& sliding_stiffness) {
     Config c;
+    c.contact.sliding_stiffness = sliding_stiffness;
     c.particles.n = 48;
     c.particles.phi_init_spheres = 0.0;  // the loose lattice
     c.flow.j = 1e-2;
@@ -188,14 +285,8 @@ TEST(SphereDynamics, PressureCellWallForceEqualsPLxLzEveryStep) {
   EXPECT_NEAR(d.wall_bodies()->driven_vx / (cell.cfg.flow.j * d.height()), 1.0, 1e-3);
 }
 
-TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
-  // Implicit springs: a sliding contact whose solved slip unloads its spring sticks, and the step
-  // is solved again with its tangential stiffness dt kt W^T W added as low-rank terms on the old
-  // factor (a contact with the floating wall also changes the wall's border of the system). A
-  // fresh assembly and factorisation with those contacts sticking must give the same
-  // velocities. Found in the sheared pressure cell of spheres, once with only particle pairs
-  // switched and once with a floating-wall contact among them.
-  SphereCell cell(5);
+void expect_resolve_equals_fresh_solve(const std::string& sliding_stiffness) {
+  SphereCell cell(5, sliding_stiffness);
   Dynamics3& d = cell.dynamics;
   auto& integrator = cell.integrator;
   std::vector<std::size_t> switched;
@@ -229,6 +320,21 @@ TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
   }
   EXPECT_TRUE(checked[0]) << "no sliding contact between spheres stuck";
   EXPECT_TRUE(checked[1]) << "no sliding contact with the floating wall stuck";
+}
+
+TEST(SphereDynamics, StickingReSolveOnTheOldFactorEqualsAFreshSolve) {
+  // Implicit springs: a sliding contact whose solved slip unloads its spring sticks, and the step
+  // is solved again with its tangential stiffness dt kt W^T W added as low-rank terms on the old
+  // factor (a contact with the floating wall also changes the wall's border of the system). A
+  // fresh assembly and factorisation with those contacts sticking must give the same
+  // velocities. Found in the sheared pressure cell of spheres, once with only particle pairs
+  // switched and once with a floating-wall contact among them; and with sliding springs stiff
+  // across their stretch (contact.sliding_stiffness), whose terms are the row along it and the
+  // rest of the row across.
+  for (const char* sliding : {"none", "sideways"}) {
+    SCOPED_TRACE(sliding);
+    expect_resolve_equals_fresh_solve(sliding);
+  }
 }
 
 }  // namespace

@@ -238,6 +238,50 @@ TEST(FrictionalContact3d, CoulombConeAndTurning) {
   EXPECT_NEAR(spring.dot(tilted), 0.0, 1e-18);
 }
 
+// A sliding spring (contact.sliding_stiffness): with "none" it has no tangential stiffness;
+// with "sideways" a slip along its stretch meets none (Coulomb holds the force there) and a slip
+// across it meets kt times the share its last cap left, cap / |trial stretch| (1 when it
+// stuck). A sticking spring meets kt either way.
+TEST(FrictionalContact3d, SlidingSpringIsStiffOnlyAcrossItsStretch) {
+  FrictionalContact none{1e4, 5e3, 0.5, false};
+  FrictionalContact sideways = none;
+  sideways.sideways = true;
+  std::mt19937_64 rng(19);
+  for (const auto& [ai, aj] : kSizePairs) {
+    const Space3 n = random_unit(rng);
+    const PairGeometry3 g = PairGeometry3::make((ai + aj - 0.01) * n, ai, aj);
+    const double cap = 0.5 * 1e4 * 0.01 / 5e3;
+    TangentialSpring3 spring;
+    spring.xi = 3.0 * cap * random_unit(rng);
+    FrictionalContact::turn_with_pair(spring.xi, n);
+    sideways.cap(spring, g);
+    ASSERT_TRUE(spring.sliding);
+    EXPECT_NEAR(spring.across, 1.0 / 3.0, 1e-12);
+    const Space3 along = spring.xi.normalized(), across = n.cross(along);
+    // Sphere i translating along e: the slip is -e, normal to n.
+    const auto moving = [](const Space3& e) {
+      Vec12 u = Vec12::Zero();
+      u.segment<3>(0) = e;
+      return u;
+    };
+    const auto work = [&](const FrictionalContact& law, bool sliding, const Space3& e) {
+      return moving(e).dot(law.stiffness_3d(g, sliding, spring.xi, spring.across) * moving(e));
+    };
+    EXPECT_NEAR(work(sideways, true, along), 0.0, 1e-9);
+    EXPECT_NEAR(work(sideways, true, across), 5e3 / 3.0, 1e-9);
+    EXPECT_NEAR(work(none, true, across), 0.0, 1e-9);
+    for (const auto* law : {&none, &sideways}) {
+      EXPECT_NEAR(work(*law, false, along), 5e3, 1e-9);
+      EXPECT_NEAR(work(*law, false, across), 5e3, 1e-9);
+    }
+    // Inside the cone it sticks, and a later slide starts from the full stiffness.
+    spring.xi *= 0.5;
+    sideways.cap(spring, g);
+    EXPECT_FALSE(spring.sliding);
+    EXPECT_EQ(spring.across, 1.0);
+  }
+}
+
 // Which sliding contacts stick once the step's slip s is solved (contact.stick_rule). The
 // stretch xi is at the cap; its trial value xi + s dt is inside the cone when shorter than xi.
 TEST(FrictionalContact3d, StickRules) {

@@ -19,6 +19,9 @@ struct TangentialSpring {
 struct TangentialSpring3 {
   Space3 xi = Space3::Zero();
   bool sliding = false;
+  // The spring's stiffness across xi over kt that its last cap left: cap / |xi before the cap|
+  // when it slid, 1 when it stuck (FrictionalContact::cap; contact.sliding_stiffness).
+  double across = 1.0;
 };
 
 // Whether the pair touches (decided at the start of a step, shared by every law) and the

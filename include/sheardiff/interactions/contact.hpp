@@ -32,12 +32,25 @@ struct FrictionalContact {
   // Coulomb leaves sliding a contact whose slip turns its stretch sideways outside the cone.
   enum class StickRule { Unloading, Coulomb };
   StickRule stick_rule = StickRule::Unloading;
+  // Between spheres a sliding contact's spring is at the cap along its stretch xi but not across
+  // it: a slip normal to xi in the tangent plane turns the spring, and with it the friction
+  // force, and Coulomb caps only its length. The capped law's tangent across xi over a step is
+  // kt cap / |trial stretch| (the radial return's). With `sideways` (contact.sliding_stiffness)
+  // the implicit step puts it in the matrix, with the ratio of the contact's last cap (a step
+  // earlier, what is known when the step is assembled); without it the direction of the force
+  // is explicit, and where the load exceeds the cap by less than the cap itself its correction
+  // overshoots and grows from step to step until the slip reverses and the contact sticks.
+  bool sideways = false;
 
   static std::optional<FrictionalContact> from(const Config& cfg) {
     const double k = cfg.contact.ktilde;
     return FrictionalContact{
-        k, cfg.contact.kt_ratio * k, cfg.contact.mu, cfg.contact.stiffness == "mean_radius",
-        cfg.contact.stick_rule == "coulomb" ? StickRule::Coulomb : StickRule::Unloading};
+        k,
+        cfg.contact.kt_ratio * k,
+        cfg.contact.mu,
+        cfg.contact.stiffness == "mean_radius",
+        cfg.contact.stick_rule == "coulomb" ? StickRule::Coulomb : StickRule::Unloading,
+        cfg.contact.sliding_stiffness == "sideways"};
   }
 
   bool has_friction() const { return mu > 0.0 && kt > 0.0; }
@@ -152,12 +165,18 @@ struct FrictionalContact {
     return scale(g) *
            (-kn * g.overlap() * normal_mode_3d(g) + kt * slip_mode_3d(g).transpose() * xi);
   }
-  Mat12 stiffness_3d(const PairGeometry3& g, bool sliding) const {
+  // Sliding, with `sideways`, the stiffness across a stretch xi in the tangent plane is
+  // across x kt.
+  Mat12 stiffness_3d(const PairGeometry3& g, bool sliding, const Space3& xi = Space3::Zero(),
+                     double across = 1.0) const {
     const Vec12 m = normal_mode_3d(g);
     Mat12 k = kn * m * m.transpose();
     if (has_friction() && !sliding) {
       const SlipMode3 w = slip_mode_3d(g);
       k += kt * w.transpose() * w;
+    } else if (has_friction() && sideways && xi.squaredNorm() > 0.0) {
+      const Vec12 r = slip_mode_3d(g).transpose() * g.n.cross(xi.normalized());
+      k += across * kt * r * r.transpose();
     }
     return scale(g) * k;
   }
@@ -194,14 +213,16 @@ struct FrictionalContact {
     const bool friction = has_friction();
     b.add_force(spring_force_3d(g, friction ? h.xi : Space3::Zero()));
     b.sliding = friction && h.sliding;
-    if (dt_implicit > 0.0) b.add_matrix(dt_implicit * stiffness_3d(g, b.sliding));
+    if (dt_implicit > 0.0) b.add_matrix(dt_implicit * stiffness_3d(g, b.sliding, h.xi, h.across));
   }
   void advance(History3& h, const PairGeometry3& g, const Vec12& u, double dt) const {
     advance_3d(h.xi, g, u, dt);
   }
   void cap(History3& h, const PairGeometry3& g) const {
     turn_with_pair(h.xi, g.n);
+    const double trial = h.xi.norm();
     h.sliding = apply_coulomb_3d(g, h.xi);
+    h.across = h.sliding && trial > 0.0 ? h.xi.norm() / trial : 1.0;
   }
   // The stick rule of spheres over a step dt (stick_rule above).
   bool sticks_3d(const Space3& xi, const Space3& s, double dt) const {

@@ -10,8 +10,9 @@ struct ContactParams {
   double ktilde = 1e4;
   double kt_ratio = 0.5;
   double mu = 0.5;
-  std::string stiffness = "uniform";     // or "mean_radius" (kn, kt x (a_i + a_j) / d)
-  std::string stick_rule = "unloading";  // or "coulomb" (FrictionalContact::StickRule)
+  std::string stiffness = "uniform";       // or "mean_radius" (kn, kt x (a_i + a_j) / d)
+  std::string stick_rule = "unloading";    // or "coulomb" (FrictionalContact::StickRule)
+  std::string sliding_stiffness = "none";  // or "sideways" (FrictionalContact::sideways)
 
   // Keys: the schema's section adapter (src/config.cpp), with real / boolean / choice.
   template <class Keys>
@@ -34,6 +35,13 @@ struct ContactParams {
              "reversal that would otherwise flip between opposite caps). The same test for "
              "discs; for spheres `coulomb` leaves sliding a contact whose slip turns it sideways "
              "without bringing it inside the cone.");
+    k.choice("contact.sliding_stiffness", {"none", "sideways"}, &ContactParams::sliding_stiffness,
+             "Implicit springs between spheres: the tangential stiffness a sliding contact puts "
+             "in the matrix (docs/model.md section 7). `none`: none, so the direction of its "
+             "friction force is explicit. `sideways`: across its stretch, kt times the ratio "
+             "cap / |trial stretch| of its last Coulomb cap (the capped spring's tangent), so "
+             "that the force turns with the slip within the step. Discs have no sideways "
+             "direction: for them the two are the same law.");
   }
 };
 

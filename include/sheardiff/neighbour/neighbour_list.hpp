@@ -28,6 +28,7 @@ struct Pair3 {
   void serialize(Archive& a) {
     a.io(i), a.io(j), a.io(kx), a.io(ky), a.io(kz);
     a.io(history.touching), a.io(history.contact.xi), a.io(history.contact.sliding);
+    if (a.layout() >= 8) a.io(history.contact.across);  // layout 7: 1, as after a stick
   }
 };
 template <class D>

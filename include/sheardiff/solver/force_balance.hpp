@@ -174,9 +174,15 @@ class ForceBalanceOf {
   template <bool kWalls>
   void assemble_pairs(const Particles& p, const Box& box, const ImposedFlow& flow,
                       const std::vector<Pair>& pairs, double dt_implicit, const WallBodies* walls);
-  // Implicit springs: the rows w of a sticking contact's tangential stiffness kt sum w w^T
-  // (one for two discs, two for two spheres).
-  static std::vector<typename D::PairVector> slip_rows(const PairGeometryOf<D>& g);
+  // Implicit springs: the rows w and their shares c of what a sliding contact adds to its
+  // tangential stiffness, kt sum c w w^T, when it sticks (one row for two discs; two for two
+  // spheres, the one across the stretch short of what the sliding spring already has there,
+  // contact.sliding_stiffness).
+  struct SlipRow {
+    typename D::PairVector w;
+    double share = 1.0;
+  };
+  std::vector<SlipRow> slip_rows(const PairGeometryOf<D>& g, const PairHistoryOf<D>& h) const;
 
   PairLaws laws_;
   std::optional<FluidLayer> fluid_;
