@@ -145,7 +145,7 @@ auto ForceBalanceOf<D>::slip_rows(const PairGeometryOf<D>& g, const PairHistoryO
     // sliding spring already has its share across it.
     const FrictionalContact::SlipMode3 w = FrictionalContact::slip_mode_3d(g);
     const Space3& xi = h.contact.xi;
-    const bool sideways = contact().sideways && xi.squaredNorm() > 0.0;
+    const bool sideways = contact().stiff_across(xi);
     const Space3 t1 = sideways ? Space3(xi.normalized()) : Space3(g.n.unitOrthogonal());
     const Space3 t2 = g.n.cross(t1);
     std::vector<SlipRow> rows{{(t1.transpose() * w).transpose(), 1.0}};
@@ -164,8 +164,13 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
                                               Velocities& out) {
   // A fresh assembly reads the contacts' new state when the update would cost more
   // back-substitutions than a factorisation (many switched contacts at large N).
+  std::vector<std::vector<SlipRow>> rows_of;
+  rows_of.reserve(switched.size());
   std::size_t rows = 0;
-  for (std::size_t k : switched) rows += slip_rows(terms_[k].g, pairs[k].history).size();
+  for (std::size_t k : switched) {
+    rows_of.push_back(slip_rows(terms_[k].g, pairs[k].history));
+    rows += rows_of.back().size();
+  }
   const bool over_budget = !system_.low_rank_pays(rows);
   sticking_.switched += static_cast<long>(switched.size());
   if (over_budget) {
@@ -176,7 +181,8 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
   const int d = system_.dof();
   constexpr int B = D::body;
   VecX w, dg;
-  for (std::size_t k : switched) {
+  for (std::size_t n = 0; n < switched.size(); ++n) {
+    const std::size_t k = switched[n];
     const Pair& pr = pairs[k];
     PairTerm& term = terms_[k];
     const double kt_full = dt_implicit * contact().kt_of(term.g);
@@ -188,7 +194,7 @@ bool ForceBalanceOf<D>::resolve_with_sticking(const Particles& p, const Box& box
                            : j_floating || mj == Motion::DrivenWall ? walls->driven_vx
                                                                     : 0.0;
     term.sliding = false;
-    for (const auto& [row, share] : slip_rows(term.g, pr.history)) {
+    for (const auto& [row, share] : rows_of[n]) {
       const double kt = share * kt_full;
       // The pair term as a new assembly would make it (stresses read it after the step).
       term.m += kt * row * row.transpose();

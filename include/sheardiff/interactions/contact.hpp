@@ -165,6 +165,10 @@ struct FrictionalContact {
     return scale(g) *
            (-kn * g.overlap() * normal_mode_3d(g) + kt * slip_mode_3d(g).transpose() * xi);
   }
+  // Whether a sliding spring xi keeps a stiffness across itself (`sideways`, and a direction).
+  bool stiff_across(const Space3& xi) const {
+    return has_friction() && sideways && xi.squaredNorm() > 0.0;
+  }
   // Sliding, with `sideways`, the stiffness across a stretch xi in the tangent plane is
   // across x kt.
   Mat12 stiffness_3d(const PairGeometry3& g, bool sliding, const Space3& xi = Space3::Zero(),
@@ -174,7 +178,7 @@ struct FrictionalContact {
     if (has_friction() && !sliding) {
       const SlipMode3 w = slip_mode_3d(g);
       k += kt * w.transpose() * w;
-    } else if (has_friction() && sideways && xi.squaredNorm() > 0.0) {
+    } else if (stiff_across(xi)) {
       const Vec12 r = slip_mode_3d(g).transpose() * g.n.cross(xi.normalized());
       k += across * kt * r * r.transpose();
     }
