@@ -24,8 +24,15 @@ is itself uncertain by 35-70 % and can be small by chance. Units of the differen
 
 With --reference-from, the reference is the points of another sweep (same protocol and seeds)
 whose --reference-axis (default: its one axis besides run.seed) equals VALUE, e.g. the md = 3e-4 d
-points of a step-size sweep against a sweep of a new step policy. An --only KEY that REF_DIR
-also has as an axis filters REF_DIR's points too (one ktilde of a sweep over several).
+points of a step-size sweep against a sweep of a new step policy. --axis and --reference-axis
+may also name a summary column the sweep holds fixed (e.g. J of a sweep over seeds only), to set
+one store against another at the same J:
+
+    /usr/bin/python3 tools/convergence_table.py results/sweep_3d_j01 --axis J \
+        --reference-from results/sweep_3d_j01_none --reference-axis J --reference 0.1
+
+An --only KEY that REF_DIR also has as an axis filters REF_DIR's points too (one ktilde of a
+sweep over several).
 """
 import argparse
 import math
@@ -84,9 +91,21 @@ def the_axis(given, axes):
     return given or (axes[0] if len(axes) == 1 else None)
 
 
+def setting(r, key):
+    """A point's value of KEY: its axis column, else (a setting its sweep holds fixed, e.g. J of a
+    sweep over seeds only) its summary column of that name."""
+    v = r.get(f"axis.{key}")
+    return float(v if v not in (None, "") else r[key])
+
+
+def has(rows, key):
+    """Whether the points have KEY as an axis or a summary column."""
+    return f"axis.{key}" in rows[0] or rows[0].get(key) not in (None, "")
+
+
 def with_value(rows, key, wanted):
-    """The rows whose axis KEY equals wanted."""
-    return [r for r in rows if float(r[f"axis.{key}"]) == wanted]
+    """The rows whose KEY (axis or summary column) equals wanted."""
+    return [r for r in rows if setting(r, key) == wanted]
 
 
 def main():
@@ -120,18 +139,19 @@ def main():
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")
         only.append((cond, key, wanted))
     axis = the_axis(a.axis, axes)
-    if axis is None or f"axis.{axis}" not in rows[0]:
-        sys.exit(f"{a.dir}: give --axis, one of {axes}")
+    if axis is None or not has(rows, axis):
+        sys.exit(f"{a.dir}: give --axis, one of {axes} or a summary column held fixed (e.g. J)")
     groups = {}
     for r in rows:
-        groups.setdefault(float(r[f"axis.{axis}"]), []).append(r)
+        groups.setdefault(setting(r, axis), []).append(r)
     if a.reference_from:
         if a.reference is None:
             sys.exit("--reference-from needs --reference VALUE (of --reference-axis)")
         ref_rows, ref_axes = finished_rows(a.reference_from)
         ref_axis = the_axis(a.reference_axis, ref_axes)
-        if ref_axis is None or f"axis.{ref_axis}" not in ref_rows[0]:
-            sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes}")
+        if ref_axis is None or not has(ref_rows, ref_axis):
+            sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes} or a summary "
+                     "column held fixed (e.g. J)")
         ref_value = a.reference
         # An --only axis that REF_DIR also varies (e.g. ktilde) selects its reference points too.
         for cond, key, wanted in only:

@@ -4,7 +4,8 @@ setting, four seeds each; the coarsest carries a bias of exactly 4 reference sta
 dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
 seed values); runs' own error bars larger than their scatter set the mean's error; an unknown
 axis must be refused; and a reference taken from another sweep (--reference-from) must give
-the same cells as the same points in one sweep; a simple-shear sweep (phi imposed) must be read
+the same cells as the same points in one sweep, also when both are sweeps over seeds only,
+set against each other at the J each holds fixed (--axis J --reference-axis J); a simple-shear sweep (phi imposed) must be read
 through its stresses, mu = shear stress / pressure. Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
@@ -144,4 +145,25 @@ assert cells[4].endswith(", +4.0)"), f"mu cell {cells[4]!r}: want r = +4.0"
 ref_cells = [c.strip() for c in next(l for l in out.splitlines()
                                      if l.startswith("| 0.0003 |")).strip("|").split("|")]
 assert ref_cells[4].startswith("0.5 +- "), f"mu cell {ref_cells[4]!r}: want 1.5 / 3"
+# Two sweeps over seeds only, each at a fixed J (the sliding laws' comparison of the 3D sweep at
+# J = 0.1): --axis J and --reference-axis J name the summary column; the biased one reads r = +4.0.
+for name, data in [("seeds_ref", [r for r in rows if r["axis.integrator.max_displacement"] == 3e-4]),
+                   ("seeds_new", [r for r in rows if r["axis.integrator.max_displacement"] == 3e-3])]:
+    (work / name).mkdir(exist_ok=True)
+    names = [c for c in cols if c != "axis.integrator.max_displacement"] + ["J"]
+    with open(work / name / "sweep.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=names, extrasaction="ignore")
+        w.writeheader()
+        w.writerows([dict(r, J=0.1) for r in data])
+out = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(work / "seeds_new"),
+                      "--axis", "J", "--reference-from", str(work / "seeds_ref"),
+                      "--reference-axis", "J", "--reference", "0.1"],
+                     capture_output=True, text=True, check=True).stdout
+cells = [c.strip() for c in next(l for l in out.splitlines()
+                                 if l.startswith("| 0.1 |")).strip("|").split("|")]
+assert cells[4].endswith(", +4.0)"), f"dv cell {cells[4]!r}: want r = +4.0 at the same J"
+bad = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), str(work / "seeds_new"),
+                      "--axis", "J", "--reference-from", str(work / "seeds_ref"),
+                      "--reference-axis", "J", "--reference", "0.05"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--reference 0.05" in bad.stderr, bad.stderr
 print("convergence_table: ok")
