@@ -8,6 +8,7 @@
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
+#include <chrono>
 #include <map>
 #include <memory>
 
@@ -353,11 +354,76 @@ void cg_previous_step_factor(benchmark::State& state) {
   state.counters["iterations_1e-10"] = it10 / pairs;
   state.counters["solves_per_factorisation"] = ratio;
 }
+// The same route for spheres, whose factorisation costs more back-solves than the discs' (a step
+// is ~80 % factorisation at N = 1000): the pressure cell of configs/sweep_3d.toml (1000 spheres,
+// aspect 1.5, sliding_stiffness = "sideways") at J = 5e-2 (range(1) = 0, started at 0.48) or 1e-3
+// (range(1) = 1, started at 0.55), 300 steps from the random start, then pairs of a factor and
+// the system range(2) steps later, solved by conjugate gradients preconditioned by that factor.
+// Counters as above, and the measured ms of a factorisation, of its first back-solve and of the
+// whole 1e-10 solve by conjugate gradients, in the same loop (a loaded machine slows them alike):
+// the kept factor pays if the conjugate gradients take less than a factorisation.
+void cg_aged_factor_spheres(benchmark::State& state) {
+  sheardiff::Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.scene.dimension = 3;
+  cfg.particles.n = static_cast<int>(state.range(0));
+  cfg.particles.aspect = 1.5;
+  cfg.contact.ktilde = 1e4;
+  cfg.contact.sliding_stiffness = "sideways";
+  cfg.flow.j = state.range(1) == 0 ? 5e-2 : 1e-3;
+  cfg.particles.phi_init_spheres = state.range(1) == 0 ? 0.48 : 0.55;
+  sheardiff::Simulation3 sim(cfg);
+  for (int k = 0; k < 300; ++k) sim.step();
+  const auto& rs = sim.dynamics().force_balance().system();
+  double it6 = 0, it10 = 0, ratio = 0, t_fact = 0, t_solve = 0, t_cg = 0;
+  using clock = std::chrono::steady_clock;
+  auto ms = [](clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  for (auto _ : state) {
+    auto previous = sheardiff::make_sparse_cholesky("cholmod");
+    previous->analyze(rs.matrix());
+    const auto t0 = clock::now();
+    previous->factorize(rs.matrix());
+    const auto t1 = clock::now();
+    Eigen::VectorXd y = previous->solve(rs.rhs());
+    const auto t2 = clock::now();
+    benchmark::DoNotOptimize(y.data());
+    t_fact += ms(t1 - t0);
+    t_solve += ms(t2 - t1);
+    ratio = previous->solves_per_factorisation();
+    for (int k = 0; k < state.range(2); ++k) sim.step();
+    const Eigen::SparseMatrix<double> full = rs.matrix().selfadjointView<Eigen::Lower>();
+    for (double tol : {1e-6, 1e-10}) {
+      Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
+                               PreviousFactor>
+          cg;
+      cg.preconditioner().set(previous.get());
+      cg.setTolerance(tol);
+      cg.compute(full);
+      const auto t3 = clock::now();
+      Eigen::VectorXd x = cg.solve(rs.rhs());
+      if (tol < 1e-8) t_cg += ms(clock::now() - t3);
+      benchmark::DoNotOptimize(x.data());
+      (tol > 1e-8 ? it6 : it10) += static_cast<double>(cg.iterations());
+    }
+  }
+  const auto pairs = static_cast<double>(state.iterations());
+  state.counters["iterations_1e-6"] = it6 / pairs;
+  state.counters["iterations_1e-10"] = it10 / pairs;
+  state.counters["cg_1e-10_ms"] = t_cg / pairs;
+  state.counters["solves_per_factorisation"] = ratio;
+  state.counters["factorise_ms"] = t_fact / pairs;
+  state.counters["back_solve_ms"] = t_solve / pairs;
+}
+
 #ifdef SHEARDIFF_HAVE_CHOLMOD
 BENCHMARK(cg_previous_step_factor)
     ->Args({1000, 30})
     ->Args({1000, 3000})
     ->Iterations(20)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(cg_aged_factor_spheres)
+    ->ArgsProduct({{1000}, {0, 1}, {1, 3, 10}})
+    ->Iterations(10)
     ->Unit(benchmark::kMillisecond);
 #endif
 
