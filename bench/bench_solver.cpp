@@ -14,6 +14,7 @@
 
 #ifdef SHEARDIFF_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
+extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 #endif
 
 #include "sheardiff/run.hpp"
@@ -219,6 +220,23 @@ void cholmod_spheres(benchmark::State& state) {
 }
 BENCHMARK(cholmod_spheres)
     ->ArgsProduct({{500, 1000, 2000}, {0, 1, 2}, {0, 2, 5, 10, 20}})
+    ->Unit(benchmark::kMillisecond);
+
+// Threads for the factorisation of spheres, whose supernodes are larger than the discs' (a dense
+// front of hundreds of rows): the spheres' tuned factor of cholmod_spheres' matrix with OpenBLAS
+// allowed range(1) threads (run under OMP_THREAD_LIMIT = the same, which caps CHOLMOD's own
+// OpenMP regions). Whether one run on two threads beats two runs side by side on one each
+// (docs/performance.md "Threads").
+void cholmod_spheres_threads(benchmark::State& state) {
+  const Problem& p = problem_spheres(static_cast<int>(state.range(0)));
+  Supernodal solver;
+  sheardiff::tune_cholmod(solver.cholmod(), 3);
+  if (openblas_set_num_threads) openblas_set_num_threads(static_cast<int>(state.range(1)));
+  time_factorise(state, p, solver);
+  if (openblas_set_num_threads) openblas_set_num_threads(1);
+}
+BENCHMARK(cholmod_spheres_threads)
+    ->ArgsProduct({{1000, 2000}, {1, 2}})
     ->Unit(benchmark::kMillisecond);
 
 // The Woodbury columns of spheres (12 non-zeros each: a pair's tangential rows), one by one
