@@ -224,7 +224,7 @@ BENCHMARK(cholmod_spheres)
 
 // Threads for the factorisation of spheres, whose supernodes are larger than the discs' (a dense
 // front of hundreds of rows): the spheres' tuned factor of cholmod_spheres' matrix with OpenBLAS
-// allowed range(1) threads (run under OMP_THREAD_LIMIT = the same, which caps CHOLMOD's own
+// allowed range(1) threads, run under OMP_THREAD_LIMIT = 1 and 2 (which caps CHOLMOD's own
 // OpenMP regions). Whether one run on two threads beats two runs side by side on one each
 // (docs/performance.md "Threads").
 void cholmod_spheres_threads(benchmark::State& state) {
