@@ -312,10 +312,7 @@ BENCHMARK(conjugate_gradient<Eigen::IncompleteCholesky<double>>)
 // A factorisation kept across steps (issue 13's route "keep a factorisation and iterate"):
 // conjugate gradients on step k+1's system, preconditioned by the exact factor of step k's, in
 // the pressure cell at J = 1e-4 (N = 1000; 30 or 3000 steps from the random packing, the second
-// 0.08 strain into its compaction, then 20 step pairs).
-// Counters: the mean iterations to a relative residual of 1e-6 and 1e-10, and the back-solves
-// one factorisation costs (CHOLMOD's flop counts): one iteration costs about one back-solve, so
-// the kept factor pays only if the iterations stay below that ratio.
+// 0.08 strain into its compaction, then 20 step pairs; counters: cg_aged_factor below).
 class PreviousFactor {
  public:
   void set(const sheardiff::SparseCholesky* f) { f_ = f; }
@@ -338,66 +335,19 @@ class PreviousFactor {
   const sheardiff::SparseCholesky* f_ = nullptr;
 };
 
-void cg_previous_step_factor(benchmark::State& state) {
-  sheardiff::Config cfg;
-  cfg.scene.type = "pressure_shear";
-  cfg.particles.n = static_cast<int>(state.range(0));
-  cfg.particles.phi_init = 0.75;
-  cfg.flow.j = 1e-4;
-  sheardiff::Simulation sim(cfg);
-  for (int k = 0; k < state.range(1); ++k) sim.step();
-  const auto& rs = sim.dynamics().force_balance().system();
-  double it6 = 0, it10 = 0, ratio = 0;
-  for (auto _ : state) {
-    auto previous = sheardiff::make_sparse_cholesky("cholmod");
-    previous->analyze(rs.matrix());
-    previous->factorize(rs.matrix());
-    ratio = previous->solves_per_factorisation();
-    sim.step();
-    const Eigen::SparseMatrix<double> full = rs.matrix().selfadjointView<Eigen::Lower>();
-    for (double tol : {1e-6, 1e-10}) {
-      Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
-                               PreviousFactor>
-          cg;
-      cg.preconditioner().set(previous.get());
-      cg.setTolerance(tol);
-      cg.compute(full);
-      Eigen::VectorXd x = cg.solve(rs.rhs());
-      benchmark::DoNotOptimize(x.data());
-      (tol > 1e-8 ? it6 : it10) += static_cast<double>(cg.iterations());
-    }
-  }
-  const auto pairs = static_cast<double>(state.iterations());
-  state.counters["iterations_1e-6"] = it6 / pairs;
-  state.counters["iterations_1e-10"] = it10 / pairs;
-  state.counters["solves_per_factorisation"] = ratio;
-}
-// The same route for spheres, whose factorisation costs more back-solves than the discs' (a step
-// is ~80 % factorisation at N = 1000): the pressure cell of configs/sweep_3d.toml (1000 spheres,
-// aspect 1.5, sliding_stiffness = "sideways") at J = 5e-2 (range(1) = 0, started at 0.48) or 1e-3
-// (range(1) = 1, started at 0.55), 300 steps from the random start, then pairs of a factor and
-// the system range(2) steps later, solved by conjugate gradients preconditioned by that factor.
-// Counters as above, and the measured ms of a factorisation, of its first back-solve and of the
-// whole 1e-10 solve by conjugate gradients, in the same loop (a loaded machine slows them alike):
-// the kept factor pays if the conjugate gradients take less than a factorisation.
-void cg_aged_factor_spheres(benchmark::State& state) {
-  sheardiff::Config cfg;
-  cfg.scene.type = "pressure_shear";
-  cfg.scene.dimension = 3;
-  cfg.particles.n = static_cast<int>(state.range(0));
-  cfg.particles.aspect = 1.5;
-  cfg.contact.ktilde = 1e4;
-  cfg.contact.sliding_stiffness = "sideways";
-  cfg.flow.j = state.range(1) == 0 ? 5e-2 : 1e-3;
-  cfg.particles.phi_init_spheres = state.range(1) == 0 ? 0.48 : 0.55;
-  sheardiff::Simulation3 sim(cfg);
-  for (int k = 0; k < 300; ++k) sim.step();
+// Pairs of a factor of sim's system and the system `age` steps later, solved by conjugate
+// gradients preconditioned by that factor to relative residuals of 1e-6 and 1e-10. Counters: the
+// mean iterations, the back-solves one factorisation costs (CHOLMOD's flop counts; one iteration
+// costs about one back-solve), and the measured ms of a factorisation, of its first back-solve and
+// of the whole 1e-10 solve, in the same loop (a loaded machine slows them alike).
+template <class Sim>
+void cg_aged_factor(benchmark::State& state, Sim& sim, int dimension, int age) {
   const auto& rs = sim.dynamics().force_balance().system();
   double it6 = 0, it10 = 0, ratio = 0, t_fact = 0, t_solve = 0, t_cg = 0;
   using clock = std::chrono::steady_clock;
   auto ms = [](clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
   for (auto _ : state) {
-    auto previous = sheardiff::make_sparse_cholesky("cholmod");
+    auto previous = sheardiff::make_sparse_cholesky("cholmod", dimension);
     previous->analyze(rs.matrix());
     const auto t0 = clock::now();
     previous->factorize(rs.matrix());
@@ -408,8 +358,8 @@ void cg_aged_factor_spheres(benchmark::State& state) {
     t_fact += ms(t1 - t0);
     t_solve += ms(t2 - t1);
     ratio = previous->solves_per_factorisation();
-    for (int k = 0; k < state.range(2); ++k) sim.step();
-    const Eigen::SparseMatrix<double> full = rs.matrix().selfadjointView<Eigen::Lower>();
+    for (int k = 0; k < age; ++k) sim.step();
+    const Eigen::SparseMatrix<double> full = rs.matrix().template selfadjointView<Eigen::Lower>();
     for (double tol : {1e-6, 1e-10}) {
       Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
                                PreviousFactor>
@@ -431,6 +381,37 @@ void cg_aged_factor_spheres(benchmark::State& state) {
   state.counters["solves_per_factorisation"] = ratio;
   state.counters["factorise_ms"] = t_fact / pairs;
   state.counters["back_solve_ms"] = t_solve / pairs;
+}
+
+void cg_previous_step_factor(benchmark::State& state) {
+  sheardiff::Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.particles.n = static_cast<int>(state.range(0));
+  cfg.particles.phi_init = 0.75;
+  cfg.flow.j = 1e-4;
+  sheardiff::Simulation sim(cfg);
+  for (int k = 0; k < state.range(1); ++k) sim.step();
+  cg_aged_factor(state, sim, 2, 1);
+}
+// The same route for spheres, whose factorisation costs more back-solves than the discs' (a step
+// is ~80 % factorisation at N = 1000): the pressure cell of configs/sweep_3d.toml (1000 spheres,
+// aspect 1.5, sliding_stiffness = "sideways") at J = 5e-2 (range(1) = 0, started at 0.48) or 1e-3
+// (range(1) = 1, started at 0.55), 300 steps from the random start, then pairs of a factor and
+// the system range(2) steps later. The kept factor pays if the conjugate gradients take less
+// than a factorisation.
+void cg_aged_factor_spheres(benchmark::State& state) {
+  sheardiff::Config cfg;
+  cfg.scene.type = "pressure_shear";
+  cfg.scene.dimension = 3;
+  cfg.particles.n = static_cast<int>(state.range(0));
+  cfg.particles.aspect = 1.5;
+  cfg.contact.ktilde = 1e4;
+  cfg.contact.sliding_stiffness = "sideways";
+  cfg.flow.j = state.range(1) == 0 ? 5e-2 : 1e-3;
+  cfg.particles.phi_init_spheres = state.range(1) == 0 ? 0.48 : 0.55;
+  sheardiff::Simulation3 sim(cfg);
+  for (int k = 0; k < 300; ++k) sim.step();
+  cg_aged_factor(state, sim, 3, static_cast<int>(state.range(2)));
 }
 
 #ifdef SHEARDIFF_HAVE_CHOLMOD
