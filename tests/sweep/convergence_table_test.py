@@ -4,9 +4,10 @@ setting, four seeds each; the coarsest carries a bias of exactly 4 reference sta
 dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0 for phi (equal
 seed values); runs' own error bars larger than their scatter set the mean's error; an unknown
 axis must be refused; and a reference taken from another sweep (--reference-from) must give
-the same cells as the same points in one sweep, also when both are sweeps over seeds only,
-set against each other at the J each holds fixed (--axis J --reference-axis J); a simple-shear sweep (phi imposed) must be read
-through its stresses, mu = shear stress / pressure. Usage: convergence_table_test.py REPO WORK"""
+the same cells as the same points in one sweep, also when both are sweeps over seeds only, set
+against each other at the J each holds fixed (--axis J --reference-axis J); a simple-shear sweep
+(phi imposed) must be read through its stresses, mu = shear stress / pressure.
+Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
 import subprocess
