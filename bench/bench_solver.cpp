@@ -14,7 +14,6 @@
 
 #ifdef SHEARDIFF_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
-extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 #endif
 
 #include "sheardiff/run.hpp"
@@ -231,9 +230,9 @@ void cholmod_spheres_threads(benchmark::State& state) {
   const Problem& p = problem_spheres(static_cast<int>(state.range(0)));
   Supernodal solver;
   sheardiff::tune_cholmod(solver.cholmod(), 3);
-  if (openblas_set_num_threads) openblas_set_num_threads(static_cast<int>(state.range(1)));
+  sheardiff::set_blas_threads(static_cast<int>(state.range(1)));
   time_factorise(state, p, solver);
-  if (openblas_set_num_threads) openblas_set_num_threads(1);
+  sheardiff::set_blas_threads(1);
 }
 BENCHMARK(cholmod_spheres_threads)
     ->ArgsProduct({{1000, 2000}, {1, 2}})

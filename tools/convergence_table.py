@@ -120,8 +120,9 @@ def main():
     ap.add_argument("--reference-axis", help="REF_DIR's axis that --reference names (default: "
                     "its one axis that is not run.seed)")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
-                    help="keep only the points whose axis KEY has this value (repeatable), e.g. "
-                    "one J of a sweep over several J against that J's reference")
+                    help="keep only the points whose axis KEY (or summary column KEY) has this "
+                    "value (repeatable), e.g. one J of a sweep over several J against that J's "
+                    "reference")
     a = ap.parse_args()
     rows, axes = finished_rows(a.dir)
     only = []
@@ -131,9 +132,9 @@ def main():
             wanted = float(value)
         except ValueError:
             wanted = None
-        if not eq or f"axis.{key}" not in rows[0] or wanted is None:
+        if not eq or wanted is None or not has(rows, key):
             sys.exit(f"--only {cond}: give KEY=VALUE, a number for an axis KEY, one of "
-                     f"{axes + ['run.seed']}")
+                     f"{axes + ['run.seed']}, or a summary column held fixed (e.g. J)")
         rows = with_value(rows, key, wanted)
         if not rows:
             sys.exit(f"--only {cond}: no finished point has {key} = {value}")

@@ -46,7 +46,7 @@ class EigenBacked final : public SparseCholesky {
 class Cholmod final : public SparseCholesky {
  public:
   explicit Cholmod(int dimension) {
-    if (openblas_set_num_threads) openblas_set_num_threads(1);
+    set_blas_threads(1);
     tune_cholmod(ordering_.cholmod(), dimension);
     // Only its P is used: a simplicial analysis orders and postorders the same way and skips
     // the supernodal symbolic factor that natural_ computes anyway.
@@ -128,6 +128,10 @@ class Cholmod final : public SparseCholesky {
 };
 
 }  // namespace
+
+void set_blas_threads(int threads) {
+  if (openblas_set_num_threads) openblas_set_num_threads(threads);
+}
 
 void tune_cholmod(cholmod_common& c, int dimension) {
   // The matrix is the contact graph of a packing: for discs nested dissection (CHOLMOD's NESDIS)

@@ -5,8 +5,8 @@ dv and none elsewhere, so its (z, r) cells must read r = +4.0 for dv and r = 0.0
 seed values); runs' own error bars larger than their scatter set the mean's error; an unknown
 axis must be refused; and a reference taken from another sweep (--reference-from) must give
 the same cells as the same points in one sweep, also when both are sweeps over seeds only, set
-against each other at the J each holds fixed (--axis J --reference-axis J); a simple-shear sweep
-(phi imposed) must be read through its stresses, mu = shear stress / pressure.
+against each other at the J each holds fixed (--axis J --reference-axis J, and --only J=...); a
+simple-shear sweep (phi imposed) must be read through its stresses, mu = shear stress / pressure.
 Usage: convergence_table_test.py REPO WORK"""
 import csv
 import pathlib
@@ -167,4 +167,14 @@ bad = subprocess.run([sys.executable, str(repo / "tools/convergence_table.py"), 
                       "--axis", "J", "--reference-from", str(work / "seeds_ref"),
                       "--reference-axis", "J", "--reference", "0.05"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--reference 0.05" in bad.stderr, bad.stderr
+# --only takes a summary column held fixed as --axis does: J = 0.1 keeps every point, J = 0.05
+# none (refused, not an empty table).
+seeds_tool = [sys.executable, str(repo / "tools/convergence_table.py"), str(work / "seeds_new"),
+              "--axis", "J", "--reference-from", str(work / "seeds_ref"), "--reference-axis", "J",
+              "--reference", "0.1"]
+out = subprocess.run(seeds_tool + ["--only", "J=0.1"], capture_output=True, text=True,
+                     check=True).stdout
+assert next(l for l in out.splitlines() if l.startswith("| 0.1 |")).startswith("| 0.1 | 4 |"), out
+bad = subprocess.run(seeds_tool + ["--only", "J=0.05"], capture_output=True, text=True)
+assert bad.returncode != 0 and "no finished point has J = 0.05" in bad.stderr, bad.stderr
 print("convergence_table: ok")

@@ -19,4 +19,7 @@ class SupernodalWithFactor : public Supernodal {
 // (dimension 2) or spheres (3) (measured, see src/solver/sparse_cholesky.cpp).
 void tune_cholmod(cholmod_common& c, int dimension = 2);
 
+// Threads of OpenBLAS, behind CHOLMOD's supernodal kernels; a no-op with another BLAS.
+void set_blas_threads(int threads);
+
 }  // namespace sheardiff
