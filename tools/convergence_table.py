@@ -86,6 +86,14 @@ def finished_rows(folder):
                   if k.startswith("axis.") and k != "axis.run.seed"]
 
 
+def stationary(rows, folder):
+    """The points whose window passed the stationarity test (status exactly 'done')."""
+    kept = [r for r in rows if r["status"] == "done"]
+    if not kept:
+        sys.exit(f"{folder}: no finished point with a stationary window")
+    return kept
+
+
 def the_axis(given, axes):
     """The axis a table is about: the one named, else the sweep's one axis besides run.seed."""
     return given or (axes[0] if len(axes) == 1 else None)
@@ -119,12 +127,18 @@ def main():
                     "from this sweep folder or store instead of DIR")
     ap.add_argument("--reference-axis", help="REF_DIR's axis that --reference names (default: "
                     "its one axis that is not run.seed)")
+    ap.add_argument("--stationary-only", action="store_true",
+                    help="leave out the points whose measured window failed the stationarity "
+                    "test (status 'done, not stationary' and the like); by default they count "
+                    "and the table names them")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
                     help="keep only the points whose axis KEY (or summary column KEY) has this "
                     "value (repeatable), e.g. one J of a sweep over several J against that J's "
                     "reference")
     a = ap.parse_args()
     rows, axes = finished_rows(a.dir)
+    if a.stationary_only:
+        rows = stationary(rows, a.dir)
     only = []
     for cond in a.only:
         key, eq, value = cond.partition("=")
@@ -149,6 +163,8 @@ def main():
         if a.reference is None:
             sys.exit("--reference-from needs --reference VALUE (of --reference-axis)")
         ref_rows, ref_axes = finished_rows(a.reference_from)
+        if a.stationary_only:
+            ref_rows = stationary(ref_rows, a.reference_from)
         ref_axis = the_axis(a.reference_axis, ref_axes)
         if ref_axis is None or not has(ref_rows, ref_axis):
             sys.exit(f"{a.reference_from}: give --reference-axis, one of {ref_axes} or a summary "
@@ -188,7 +204,14 @@ def main():
           f"Cells: mean over seeds +- standard error of the mean (the larger of the "
           f"seeds' scatter and the runs' own error bars); "
           f"(z, r) = difference from the reference in combined standard errors and in the "
-          f"reference's standard error.\n")
+          f"reference's standard error.")
+    flagged = sorted({r["point"] + " (" + r["status"] + ")"
+                      for rs in groups.values() for r in rs if r["status"] != "done"})
+    if a.reference_from:
+        flagged += [f"{r['point']} of {a.reference_from} ({r['status']})" for r in ref_group
+                    if r["status"] != "done"]
+    print(("Counted although their window failed the stationarity test (--stationary-only "
+           "leaves them out): " + ", ".join(flagged) + ".\n") if flagged else "")
     print("| " + axis + " | seeds | " + " | ".join(h for _, h in quantities)
           + " | steps / strain | run s / strain |")
     print("|---" * (len(quantities) + 4) + "|")

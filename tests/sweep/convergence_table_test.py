@@ -6,6 +6,7 @@ seed values); runs' own error bars larger than their scatter set the mean's erro
 axis must be refused; and a reference taken from another sweep (--reference-from) must give
 the same cells as the same points in one sweep, also when both are sweeps over seeds only, set
 against each other at the J each holds fixed (--axis J --reference-axis J, and --only J=...); a
+window that failed the stationarity test is named, and left out with --stationary-only; a
 simple-shear sweep (phi imposed) must be read through its stresses, mu = shear stress / pressure.
 Usage: convergence_table_test.py REPO WORK"""
 import csv
@@ -177,4 +178,27 @@ out = subprocess.run(seeds_tool + ["--only", "J=0.1"], capture_output=True, text
 assert next(l for l in out.splitlines() if l.startswith("| 0.1 |")).startswith("| 0.1 | 4 |"), out
 bad = subprocess.run(seeds_tool + ["--only", "J=0.05"], capture_output=True, text=True)
 assert bad.returncode != 0 and "no finished point has J = 0.05" in bad.stderr, bad.stderr
+# A window that failed the stationarity test counts by default and is named; --stationary-only
+# leaves it out: a fifth seed far off in dv, flagged, moves the mean only without the flag.
+flagged_dir = work / "seeds_flagged"
+flagged_dir.mkdir(exist_ok=True)
+data = [r for r in rows if r["axis.integrator.max_displacement"] == 3e-3]
+flagged_row = dict(data[0], point="md=0.003_seed=5", status="done, not stationary", dv=103.0)
+names = [c for c in cols if c != "axis.integrator.max_displacement"] + ["J"]
+with open(flagged_dir / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=names, extrasaction="ignore")
+    w.writeheader()
+    w.writerows([dict(r, J=0.1) for r in data + [flagged_row]])
+flagged_tool = [sys.executable, str(repo / "tools/convergence_table.py"), str(flagged_dir), "--axis",
+                "J", "--reference-from", str(work / "seeds_ref"), "--reference-axis", "J",
+                "--reference", "0.1"]
+out = subprocess.run(flagged_tool, capture_output=True, text=True, check=True).stdout
+assert "md=0.003_seed=5 (done, not stationary)" in out, out
+assert next(l for l in out.splitlines() if l.startswith("| 0.1 |")).startswith("| 0.1 | 5 |"), out
+out = subprocess.run(flagged_tool + ["--stationary-only"], capture_output=True, text=True,
+                     check=True).stdout
+assert "seed=5" not in out, out
+cells = [c.strip() for c in next(l for l in out.splitlines()
+                                 if l.startswith("| 0.1 |")).strip("|").split("|")]
+assert cells[1] == "4" and cells[4].endswith(", +4.0)"), f"without the flagged seed: {cells}"
 print("convergence_table: ok")
