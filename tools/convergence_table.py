@@ -87,8 +87,8 @@ def finished_rows(folder):
 
 
 def stationary(rows, folder):
-    """The points whose window passed the stationarity test (status exactly 'done')."""
-    kept = [r for r in rows if r["status"] == "done"]
+    """The points whose window passed the stationarity test."""
+    kept = [r for r in rows if rundir.is_stationary(r)]
     if not kept:
         sys.exit(f"{folder}: no finished point with a stationary window")
     return kept
@@ -206,10 +206,10 @@ def main():
           f"(z, r) = difference from the reference in combined standard errors and in the "
           f"reference's standard error.")
     flagged = sorted({r["point"] + " (" + r["status"] + ")"
-                      for rs in groups.values() for r in rs if r["status"] != "done"})
+                      for rs in groups.values() for r in rs if not rundir.is_stationary(r)})
     if a.reference_from:
         flagged += [f"{r['point']} of {a.reference_from} ({r['status']})" for r in ref_group
-                    if r["status"] != "done"]
+                    if not rundir.is_stationary(r)]
     print(("Counted although their window failed the stationarity test (--stationary-only "
            "leaves them out): " + ", ".join(flagged) + ".\n") if flagged else "")
     print("| " + axis + " | seeds | " + " | ".join(h for _, h in quantities)

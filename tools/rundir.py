@@ -117,6 +117,18 @@ class Run:
         return tomllib.loads(self.file("config").read_text()) if self.has("config") else {}
 
 
+# sweep.csv's status of a point whose window passed the stationarity test (src/sweep/collect.cpp).
+STATIONARY = "done"
+# The finished points that reached the steady state but whose window then failed the
+# stationarity test; `sheardiff fit --include-not-stationary` fits them too. "done, not steady"
+# (the run ended before the steady-state test passed) is not among them: it has no window.
+NOT_STATIONARY = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
+
+
+def is_stationary(row):
+    return row["status"] == STATIONARY
+
+
 class Store:
     """A sweep's results store (results/NAME) or sweep folder, finished or not."""
 
@@ -143,10 +155,9 @@ class Store:
     def fitted_rows(self):
         """The rows whose measurements the fits used: the stationary ones, and the flagged ones
         too when the fit was made with `sheardiff fit --include-not-stationary`."""
-        flagged = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
         with_flagged = self.fits.get("includes_not_stationary")
         return [r for r in self.rows()
-                if r["status"] == "done" or (with_flagged and r["status"] in flagged)]
+                if is_stationary(r) or (with_flagged and r["status"] in NOT_STATIONARY)]
 
     @property
     def fits(self):
