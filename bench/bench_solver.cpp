@@ -427,4 +427,4 @@ BENCHMARK(cg_aged_factor_spheres)
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// main: bench/main.cpp

@@ -183,4 +183,4 @@ BENCHMARK(full_step)->Apply(variants);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// main: bench/main.cpp

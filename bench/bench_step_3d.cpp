@@ -201,4 +201,4 @@ BENCHMARK(full_step)->Apply(sizes);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// main: bench/main.cpp

@@ -28,6 +28,7 @@
 
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/solver/blas_kernels.hpp"
 
 namespace {
 
@@ -224,6 +225,7 @@ double rms_deviation(const std::vector<Vec2>& a, const std::vector<Vec2>& b) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  sheardiff::set_solver_environment(argv);  // as sheardiff runs (blas_kernels.hpp)
   CLI::App app{"Run time against error of every integrator and step-size setting"};
   Options o;
   app.add_flag("--full", o.full, "Full grid: J in {1e-1..1e-4}, ktilde in {1e3, 1e4, 1e5}");

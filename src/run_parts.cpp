@@ -17,6 +17,7 @@
 #include "sheardiff/observe/shear_analyses.hpp"
 #include "sheardiff/run_extension.hpp"
 #include "sheardiff/scene/registry.hpp"
+#include "sheardiff/solver/blas_kernels.hpp"
 #include "sheardiff/version.hpp"
 
 namespace sheardiff {
@@ -318,6 +319,10 @@ nlohmann::json run_summary(const Config& cfg, RunningStateOf<D>& run, double wal
   js[summary_key::version] = version();
   js[summary_key::git_hash] = git_hash();
   js[summary_key::host] = host_name();
+  if (const auto kernels = openblas_kernels())
+    js[summary_key::blas_kernels] = *kernels;
+  else
+    js[summary_key::blas_kernels] = nullptr;
   js[summary_key::seed] = cfg.run.seed;
   if (run.started >= 0)
     js[summary_key::started] =

@@ -25,6 +25,7 @@
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/observe/run_health.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/solver/blas_kernels.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 #include "sheardiff/version.hpp"
 
@@ -440,15 +441,9 @@ int exit_code_of_failure(const std::string& out_dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // CHOLMOD (Debian's build) opens OpenMP regions with a fixed num_threads clause inside its
-  // supernodal factorisation; only OMP_THREAD_LIMIT, read when libgomp loads, caps them. Spare
-  // threads spin and cost a shared 2-core machine ~40%, and sweeps already run one process per
-  // core, so sheardiff runs single-threaded unless the caller sets OMP_THREAD_LIMIT itself
-  // (docs/performance.md). Setting it needs a fresh process image: re-execute once.
-  if (std::getenv("OMP_THREAD_LIMIT") == nullptr) {
-    setenv("OMP_THREAD_LIMIT", "1", 1);
-    execv("/proc/self/exe", argv);  // returns only on failure: then run as we are
-  }
+  // One solver thread and OpenBLAS kernels that use the CPU's vectors, unless the caller says
+  // otherwise (docs/performance.md "Threads", "The BLAS kernels"): may re-execute once.
+  sheardiff::set_solver_environment(argv);
   sheardiff::quiet_hdf5_for_process();
   CommandLine cl;
   try {

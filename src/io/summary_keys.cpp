@@ -20,6 +20,9 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "short git commit of the build; \"-dirty\" if tracked files had changes, \"unknown\" "
             "outside a checkout"},
            {sk::host, "-", "host name of the machine that finished the run"},
+           {sk::blas_kernels, "-",
+            "OpenBLAS's kernel set on that machine (\"Cooperlake\", \"Haswell\"; "
+            "docs/performance.md \"The BLAS kernels\"); null when the BLAS is not OpenBLAS"},
            {sk::seed, "-", "`run.seed`: seeds the packing and the MSD reference times"},
            {sk::started, "ISO 8601 UTC",
             "when the run first started (kept across resumes); null when a checkpoint of an older "

@@ -66,4 +66,27 @@ if not bad and s["started"] > s["finished"]: bad.append("started after finished"
 sys.exit("; ".join(bad) if bad else 0)
 PY
 grep -q "^=== .*, sheardiff .* (git $hash): " r/run.log || fail "run.log header: $(head -1 r/run.log)"
-echo "ok: --version '$out', GitVersion.cmake, summary.json and run.log header"
+# The BLAS kernels (docs/performance.md "The BLAS kernels"): summary.json names OpenBLAS's set;
+# they use the CPU's widest vectors OpenBLAS has kernels for (an OpenBLAS too old for the CPU
+# falls back to SSE3 "Prescott" unless sheardiff asks for them), and a caller's
+# OPENBLAS_CORETYPE is kept.
+"$py" - r/summary.json <<'PY' || fail "blas_kernels"
+import json, sys
+k = json.load(open(sys.argv[1])).get("blas_kernels", "missing")
+if k is None: sys.exit(0)  # not OpenBLAS
+width = {"Prescott": 0, "Core2": 0, "Penryn": 0, "Dunnington": 0, "Nehalem": 0, "Atom": 0,
+         "Sandybridge": 1, "Haswell": 2, "Zen": 2, "SkylakeX": 3, "Cooperlake": 3,
+         "SapphireRapids": 3}
+flags = set()
+for line in open("/proc/cpuinfo"):
+    if line.startswith("flags"): flags = set(line.split(":", 1)[1].split()); break
+cpu = 3 if {"avx512f", "avx512bw", "avx512vl", "avx512dq"} <= flags else 2 if {"avx2", "fma"} <= flags else 0
+if k not in width: sys.exit(f"blas_kernels = {k!r}, not an OpenBLAS x86-64 kernel set")
+if width[k] < cpu: sys.exit(f"blas_kernels = {k!r} on a CPU with {'AVX-512' if cpu == 3 else 'AVX2'}")
+PY
+if [ "$("$py" -c 'import json; print(json.load(open("r/summary.json"))["blas_kernels"])')" != None ]; then
+  OPENBLAS_CORETYPE=Haswell "$bin" run run.toml --out r2 > run2.out 2>&1 || fail "run: $(cat run2.out)"
+  grep -q '"blas_kernels": "Haswell"' r2/summary.json || fail "OPENBLAS_CORETYPE=Haswell not kept"
+fi
+
+echo "ok: --version '$out', GitVersion.cmake, summary.json, run.log header and BLAS kernels"

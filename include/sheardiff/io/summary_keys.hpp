@@ -18,6 +18,7 @@ namespace summary_key {
 inline constexpr const char* version = "version";
 inline constexpr const char* git_hash = "git_hash";
 inline constexpr const char* host = "host";
+inline constexpr const char* blas_kernels = "blas_kernels";
 inline constexpr const char* seed = "seed";
 inline constexpr const char* started = "started";
 inline constexpr const char* finished = "finished";
