@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "sheardiff/solver/blas_kernels.hpp"
 
 using sheardiff::openblas_coretype_upgrade;
@@ -32,4 +34,15 @@ TEST(BlasKernels, NeverStepsDownOrGuessesAnUnknownSet) {
   EXPECT_EQ(openblas_coretype_upgrade("SapphireRapids", VectorIsa::avx512), std::nullopt);
   EXPECT_EQ(openblas_coretype_upgrade("Zen5", VectorIsa::older), std::nullopt);
   EXPECT_EQ(openblas_coretype_upgrade("", VectorIsa::avx512), std::nullopt);
+}
+
+// tests/unit/main.cpp sets the kernels as sheardiff does: the ones loaded here are as wide as
+// the CPU allows (unless the caller set OPENBLAS_CORETYPE).
+TEST(BlasKernels, TheTestsRunTheKernelsARunUses) {
+  const auto loaded = sheardiff::openblas_kernels();
+  if (!loaded) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  const auto upgrade = openblas_coretype_upgrade(*loaded, sheardiff::cpu_vector_isa());
+  // Narrower kernels with OPENBLAS_CORETYPE set are the caller's choice, which main keeps.
+  if (upgrade && std::getenv("OPENBLAS_CORETYPE") != nullptr) GTEST_SKIP() << "caller's choice";
+  EXPECT_EQ(upgrade, std::nullopt) << "OpenBLAS runs " << *loaded;
 }
