@@ -15,6 +15,8 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --every-j DIR  # only every J against the seed's laws
     /usr/bin/python3 tools/results_table.py --means DIR    # only the means over seeds at every J
     /usr/bin/python3 tools/results_table.py --boyer DIR    # only every J against Boyer et al.
+    /usr/bin/python3 tools/results_table.py --discs DISC_DIR DIR   # spheres' D, dv, Psi, mu
+                                                                   # against the discs'
 
 A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
 Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
@@ -106,6 +108,11 @@ def main():
         if len(sys.argv) < 4:
             sys.exit(f"usage: {sys.argv[0]} --compare REF_POINT POINT [POINT ...]")
         compare(sys.argv[2:])
+        return
+    if len(sys.argv) >= 2 and sys.argv[1] == "--discs":
+        if len(sys.argv) != 4:
+            sys.exit(f"usage: {sys.argv[0]} --discs DISC_DIR DIR (two fit or sweep folders)")
+        against_discs(one_group_rows(sys.argv[2]), one_group_rows(sys.argv[3]))
         return
     modes = ("--laws", "--every-j", "--means", "--boyer")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
@@ -256,6 +263,67 @@ def against_boyer(rows, heading=True):
             cells += [c, f"{ref:.{p}g}", f"{x / ref:.3f}"]
         print(f"| {J:g} | {r['runs']} | " + " | ".join(cells) + " |")
     print()
+
+
+def one_group_rows(path):
+    """The per-J rows of a store with one group of points."""
+    store = rundir.Store(pathlib.Path(path))
+    if not store.has_table():
+        sys.exit(f"{path}: no fits.json / sweep.csv")
+    groups = store.fits.get("groups") or []
+    if len(groups) != 1:
+        sys.exit(f"{path}: needs one group of points, not {len(groups)}")
+    return groups[0]["rows"]
+
+
+def standard_error(r, q):
+    """The larger of the seeds' scatter over sqrt(n) and the runs' own error bars over sqrt(n):
+    a scatter of two or three seeds is itself uncertain by 50-70 %."""
+    errs = [e for e in (r.get(q + "_sem"), r.get(q + "_run_err")) if e is not None]
+    return max(errs) if errs else None
+
+
+def interpolated(rows, q, J):
+    """q of a store at J: the row's at that J, else a power law between the two neighbouring J
+    (both values and their standard errors; None outside the store's J range)."""
+    pts = sorted((r["J"], r[q], standard_error(r, q)) for r in rows if r.get(q) is not None)
+    for (j0, x0, e0), (j1, x1, e1) in zip(pts, pts[1:]):
+        if j0 <= J <= j1:
+            if J == j0:
+                return x0, e0, "measured"
+            if J == j1:
+                return x1, e1, "measured"
+            w = math.log(J / j0) / math.log(j1 / j0)
+            x = math.exp((1 - w) * math.log(x0) + w * math.log(x1))
+            e = x * math.hypot((1 - w) * e0 / x0, w * e1 / x1) if e0 and e1 else None
+            return x, e, f"between J = {j0:g} and {j1:g}"
+    if pts and J == pts[-1][0]:
+        return pts[-1][1], pts[-1][2], "measured"
+    return None, None, "outside the discs' J"
+
+
+def against_discs(disc_rows, sphere_rows):
+    """Spheres against discs at the same J: D, dv, Psi and mu, each the mean over seeds +- its
+    standard error (standard_error), the discs' interpolated as power laws in J between their two
+    neighbouring J where they have no point at that J."""
+    print("| J | seeds | D / (gammadot d^2) | discs | ratio | dv / (gammadot d) | discs | ratio "
+          "| Psi gammadot | discs | ratio | mu | discs | ratio | discs' value |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in sorted(sphere_rows, key=lambda r: r["J"]):
+        J, cells, hows = r["J"], [], []
+        for q, p in (("D", 3), ("dv", 3), ("psi", 3), ("mu", 3)):
+            x = r.get(q)
+            e = standard_error(r, q)
+            ref, ref_e, how = interpolated(disc_rows, q, J)
+            if ref is not None and how not in hows:
+                hows.append(how)
+            if x is None or ref is None:
+                cells += [pm(x, e, p), pm(ref, ref_e, p), "-"]
+                continue
+            ratio = x / ref
+            ratio_e = ratio * math.hypot((e or 0) / x, (ref_e or 0) / ref)
+            cells += [pm(x, e, p), pm(ref, ref_e, p), f"{ratio:.3f} +- {ratio_e:.3f}"]
+        print(f"| {J:g} | {r['runs']} | " + " | ".join(cells) + f" | {'; '.join(hows) or '-'} |")
 
 
 def against_seed_laws(rows, heading=True, dimension=2):

@@ -1,11 +1,12 @@
 #!/usr/bin/python3
 """Was a pressure-cell window stationary? Two uses (docs/model.md, "Steady state").
 
-  stationarity_check.py store RESULTS_DIR
+  stationarity_check.py store RESULTS_DIR... [--markdown]
       Every stored point: its run's verdict (`stationary`, `not_stationary`) where the run
       recorded one; for points run before the verdict existed, the one signal their summaries
       still hold, mu_top - mu_bottom against its error (the two walls' errors combined as if
-      independent, an approximation).
+      independent, an approximation). --markdown prints one table of all the stores' points
+      with a verdict, for a generated block of the docs (tools/doc_tables.py).
 
   stationarity_check.py approach RUN_DIR [--window W] [--block B] [--z Z] [--tolerance T]
       A run's trajectory observables (H, mu_top, mu_bottom, net_drag_y, bulk_normal_load) in
@@ -15,6 +16,7 @@
 """
 import argparse
 import math
+import pathlib
 import sys
 
 import numpy as np
@@ -50,6 +52,33 @@ def store(path):
           "their standard errors; the old summaries hold only the walls' mu)")
     for _, name, verdict in sorted(rows):
         print(f"{name:28s} {verdict}")
+
+
+def markdown(paths):
+    """One table of every point of the stores that recorded a verdict; points without one are
+    named below it."""
+    print("| store | point | phi | net y drag / P | mu_top - mu_bottom | H change / d "
+          "| bulk normal load / P | verdict |")
+    print("|---|---|---|---|---|---|---|---|")
+    without = []
+    for path in paths:
+        rows = []
+        for point in rundir.Store(path).points():
+            s, name = point.summary, point.path.name
+            if "stationary" not in s:
+                without.append(f"{path}/{name}")
+                continue
+            cells = ["{:+.3f} +- {:.3f}".format(s[k], s[k + "_err"])
+                     if k in s and k + "_err" in s else "-" for k in SIGNALS]
+            verdict = "stationary" if s["stationary"] else "drifting: " + s.get("not_stationary", "")
+            rows.append((s.get("J", math.nan), name, "| {} | {} | {:.4f} | {} | {} |".format(
+                pathlib.PurePath(path).name, name, s.get("phi", math.nan), " | ".join(cells),
+                verdict)))
+        for _, _, row in sorted(rows):
+            print(row)
+    if without:
+        print("\nNo stationarity verdict recorded (run before the test existed): "
+              + ", ".join(without) + ".")
 
 
 def block_stats(x, t, lo, hi, blocks):
@@ -113,7 +142,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="what", required=True)
     s = sub.add_parser("store")
-    s.add_argument("results")
+    s.add_argument("results", nargs="+")
+    s.add_argument("--markdown", action="store_true")
     a = sub.add_parser("approach")
     a.add_argument("run")
     a.add_argument("--window", type=float, default=10.0)
@@ -122,7 +152,11 @@ def main():
     a.add_argument("--tolerance", type=float, default=0.05)
     args = ap.parse_args()
     if args.what == "store":
-        store(args.results)
+        if args.markdown:
+            markdown(args.results)
+        else:
+            for path in args.results:
+                store(path)
     else:
         if not (args.window > 0 and args.block > 0 and args.z > 0 and args.tolerance > 0):
             sys.exit("stationarity_check.py: --window, --block, --z and --tolerance must be > 0")

@@ -71,4 +71,31 @@ cells = [c.strip() for c in other.strip("|").split("|")]
 assert cells[3] == "0.11 +- 0.003 (1.100, z +2.4)", cells[3]
 assert cells[1] == "0.8 +- 0.001 (1.000, z +0.0)", cells[1]
 assert cells[6] == "-", cells[6]
-print("results_table: per-J ratios, cost table, refusal and --compare as expected")
+# --discs: discs with D = 0.1 J^-1/2 at J = 0.01 and 0.04 (errors 1 %), spheres at J = 0.02
+# with half that D and at J = 0.04 with the same: the discs' D at 0.02 is the power law between
+# their neighbours, exactly 0.1 x 0.02^-1/2, so the ratios are 0.500 and 1.000.
+def store(path, rows):
+    path.mkdir(exist_ok=True)
+    (path / "fits.json").write_text(json.dumps(
+        {"points": len(rows), "finished": len(rows), "groups": [{"axes": {}, "rows": rows}]}))
+    (path / "sweep.csv").write_text("point,status\n")
+
+
+def d_row(J, scale, runs):
+    D = scale * 0.1 * J ** -0.5
+    return {"J": J, "runs": runs, "D": D, "D_sem": 0.01 * D, "D_run_err": 0.005 * D}
+
+
+store(work / "discs", [d_row(0.01, 1.0, 3), d_row(0.04, 1.0, 3)])
+store(work / "spheres", [d_row(0.02, 0.5, 3), d_row(0.04, 1.0, 2)])
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--discs",
+                      str(work / "discs"), str(work / "spheres")],
+                     capture_output=True, text=True, check=True).stdout
+rows = {l.split("|")[1].strip(): [c.strip() for c in l.strip("|").split("|")]
+        for l in out.splitlines() if l.startswith("| 0.0")}
+assert rows["0.02"][3].startswith("0.707 +- "), rows["0.02"]
+assert rows["0.02"][4] == "0.500 +- 0.006", rows["0.02"]
+assert rows["0.02"][-1] == "between J = 0.01 and 0.04", rows["0.02"]
+assert rows["0.04"][4].startswith("1.000 +- ") and rows["0.04"][-1] == "measured", rows["0.04"]
+assert rows["0.02"][6] == "-", rows["0.02"]  # no dv in either store
+print("results_table: per-J ratios, cost table, refusal, --compare and --discs as expected")

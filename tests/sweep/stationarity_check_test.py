@@ -1,0 +1,36 @@
+#!/usr/bin/python3
+"""tools/stationarity_check.py store --markdown on two synthetic stores with a known answer: a
+stationary point, a drifting one (its reason kept) and an old point without a verdict, which is
+named below the table, not given a row. Usage: stationarity_check_test.py REPO WORK"""
+import json
+import pathlib
+import subprocess
+import sys
+
+repo, work = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+signals = {"net_drag_y": 0.01, "net_drag_y_err": 0.02, "mu_top_minus_bottom": -0.005,
+           "mu_top_minus_bottom_err": 0.01, "H_change": 0.2, "H_change_err": 0.04,
+           "bulk_normal_load": 1.01, "bulk_normal_load_err": 0.01}
+points = {"a": {"J=0.02_seed=1": dict(signals, J=0.02, phi=0.5012, stationary=True),
+                "J=0.01_seed=1": dict(signals, J=0.01, phi=0.52, stationary=False,
+                                      not_stationary="H_change")},
+          "b": {"J=0.1_seed=1": {"J": 0.1, "phi": 0.43, "mu_top": 0.9, "mu_bottom": 0.91}}}
+for store, runs in points.items():
+    for name, summary in runs.items():
+        d = work / store / "points" / name
+        d.mkdir(parents=True, exist_ok=True)
+        (d / "summary.json").write_text(json.dumps(summary))
+out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "store",
+                      "--markdown", str(work / "a"), str(work / "b")],
+                     capture_output=True, text=True, check=True).stdout
+lines = out.splitlines()
+rows = [l for l in lines if l.startswith("| a |") or l.startswith("| b |")]
+assert len(rows) == 2, out
+# Sorted by J within a store: the drifting J = 0.01 first.
+assert rows[0] == ("| a | J=0.01_seed=1 | 0.5200 | +0.010 +- 0.020 | -0.005 +- 0.010 "
+                   "| +0.200 +- 0.040 | +1.010 +- 0.010 | drifting: H_change |"), rows[0]
+assert rows[1].startswith("| a | J=0.02_seed=1 | 0.5012 |") and rows[1].endswith(
+    "| stationary |"), rows[1]
+assert lines[-1].startswith("No stationarity verdict recorded") and "b/points" not in lines[-1] \
+    and lines[-1].rstrip(".").endswith("b/J=0.1_seed=1"), lines[-1]
+print("stationarity_check: --markdown rows, order and the points without a verdict as expected")
