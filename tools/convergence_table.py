@@ -33,6 +33,14 @@ one store against another at the same J:
 
 An --only KEY that REF_DIR also has as an axis filters REF_DIR's points too (one ktilde of a
 sweep over several).
+
+With --first-order (an axis of integrator.max_displacement), each other step h also estimates
+the reference step h0's own bias, if the error is first order in the step (q(h) = q(0) + c h,
+docs/performance.md "Matched trajectory error"): q(h0) - q(0) = (q(h) - q(h0)) h0 / (h - h0),
++- the combined standard error times |h0 / (h - h0)|, and r = that bias over the reference's
+standard error. h0 is the reference's integrator.max_displacement, read from its points'
+config.toml when the reference comes from another sweep. From a step three times coarser the
+bias is half the shift.
 """
 import argparse
 import math
@@ -40,6 +48,7 @@ import sys
 
 import rundir
 
+STEP = "integrator.max_displacement"
 QUANTITIES = [("phi", "phi"), ("mu", "mu"), ("dv", "dv / (gammadot d)"),
               ("psi", "Psi gammadot"), ("D", "D / (gammadot d^2)"),
               ("max_overlap", "largest overlap / d")]
@@ -131,6 +140,9 @@ def main():
                     help="leave out the points whose measured window failed the stationarity "
                     "test (status 'done, not stationary' and the like); by default they count "
                     "and the table names them")
+    ap.add_argument("--first-order", action="store_true",
+                    help="with --axis integrator.max_displacement: the reference step's own bias "
+                    "estimated from each other step, if the error is first order in the step")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
                     help="keep only the points whose axis KEY (or summary column KEY) has this "
                     "value (repeatable), e.g. one J of a sweep over several J against that J's "
@@ -233,6 +245,52 @@ def main():
         secs = mean_sem([float(r["wall_seconds"]) / float(r["strain"]) for r in rs
                          if r.get("wall_seconds") and r.get("strain")])[0]
         print(f"| {label} | {len(rs)} | " + " | ".join(cells) + f" | {g(steps)} | {g(secs)} |")
+    if a.first_order:
+        first_order(a, axis, ref_value, ref_group, groups, quantities, stats, ref)
+
+
+def reference_step(a, axis, ref_value, ref_group):
+    """The reference points' integrator.max_displacement: the axis value, or their config's."""
+    if not a.reference_from and axis == STEP:
+        return ref_value
+    folder = rundir.Store(a.reference_from or a.dir)
+    steps = set()
+    for r in ref_group:
+        cfg = rundir.Run(folder.path / "points" / r["point"]).config
+        if "max_displacement" not in cfg.get("integrator", {}):
+            sys.exit(f"--first-order: {r['point']} of {folder.path} has no config.toml with "
+                     f"integrator.max_displacement")
+        steps.add(float(cfg["integrator"]["max_displacement"]))
+    if len(steps) != 1:
+        sys.exit(f"--first-order: the reference points ran with several steps {sorted(steps)}")
+    return steps.pop()
+
+
+def first_order(a, axis, ref_value, ref_group, groups, quantities, stats, ref):
+    if axis != STEP:
+        sys.exit(f"--first-order needs --axis {STEP}")
+    h0 = reference_step(a, axis, ref_value, ref_group)
+    print(f"\nThe reference step's own bias q(h0) - q(0), h0 = {h0:g} d, if the error is first "
+          f"order in the step (+- its standard error; r = over the reference's):\n")
+    print("| from h | " + " | ".join(hd for _, hd in quantities) + " |")
+    print("|---" * (len(quantities) + 1) + "|")
+    for h, rs in sorted(groups.items(), reverse=True):
+        if h == h0 and not a.reference_from:
+            continue
+        if h == h0:
+            sys.exit(f"--first-order: the rows at h = {h:g} ran with the reference's own step")
+        factor = h0 / (h - h0)
+        cells = []
+        for q, _ in quantities:
+            m, e = stats(rs, q)
+            rm, re = ref[q]
+            if m is None or rm is None or not re:
+                cells.append("-")
+                continue
+            bias = (m - rm) * factor + 0.0  # + 0.0: no "-0" for an exact zero
+            err = math.hypot(e or 0.0, re) * abs(factor)
+            cells.append(f"{bias:+.2g} +- {err:.2g} (r {bias / re:+.1f})")
+        print(f"| {h:g} | " + " | ".join(cells) + " |")
 
 if __name__ == "__main__":
     main()

@@ -42,6 +42,39 @@ assert "(" not in cells[2], f"phi cell {cells[2]!r}: equal seeds have no error, 
 line = next(l for l in out.splitlines() if l.startswith("| 0.001 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[4].endswith("(+0.0, +0.0)"), f"dv cell {cells[4]!r}: want no bias"
+# --first-order against md = 1e-3: the 3e-3 row's dv shift of 4 reference errors says the
+# reference is 4 x 1e-3 / (3e-3 - 1e-3) = 2 of its errors from q(0) (r = +2.0); the unbiased
+# 3e-4 row says 0; phi (equal everywhere) has no error, so no estimate.
+out = subprocess.run(tool + ["--reference", "1e-3", "--first-order"], capture_output=True,
+                     text=True, check=True).stdout
+est = out[out.index("own bias"):].splitlines()
+row = [c.strip() for c in next(l for l in est if l.startswith("| 0.003 |")).strip("|").split("|")]
+assert row[3].endswith("(r +2.0)") and row[1] == "-", row
+row = [c.strip() for c in next(l for l in est if l.startswith("| 0.0003 |")).strip("|").split("|")]
+assert row[3].endswith("(r +0.0)"), row
+assert not any(l.startswith("| 0.001 |") for l in est), "the reference's own row has no estimate"
+# Its reference step from another sweep's points' config.toml (a sweep over seeds at md = 1e-3).
+seeds_md = work / "seeds_md"
+(seeds_md / "points").mkdir(parents=True, exist_ok=True)
+with open(seeds_md / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=cols[:2] + ["axis.run.seed", "J"] + cols[4:])
+    w.writeheader()
+    for r in rows:
+        if r["axis.integrator.max_displacement"] == 1e-3:
+            ref_row = {k: v for k, v in r.items() if k != "axis.integrator.max_displacement"}
+            ref_row.update(point=f"seed={r['axis.run.seed']}", J=0.01)
+            w.writerow(ref_row)
+            d = seeds_md / "points" / ref_row["point"]
+            d.mkdir(exist_ok=True)
+            (d / "config.toml").write_text("[integrator]\nmax_displacement = 0.001\n")
+out = subprocess.run(tool + ["--only", "integrator.max_displacement=3e-3", "--reference-from",
+                             str(seeds_md), "--reference-axis", "J", "--reference", "0.01",
+                             "--first-order"], capture_output=True, text=True, check=True).stdout
+est = out[out.index("h0 = 0.001 d"):].splitlines()
+row = [c.strip() for c in next(l for l in est if l.startswith("| 0.003 |")).strip("|").split("|")]
+assert row[3].endswith("(r +2.0)"), row
+bad = subprocess.run(tool + ["--axis", "run.seed", "--first-order"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--first-order needs" in bad.stderr, bad.stderr
 # Runs whose own error bars exceed their scatter: the mean's error is rms(psi_err) / sqrt(n).
 cols.append("psi_err")
 for r in rows:
