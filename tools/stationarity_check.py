@@ -27,15 +27,19 @@ import rundir
 SIGNALS = ("net_drag_y", "mu_top_minus_bottom", "H_change", "bulk_normal_load")
 
 
+def signal_cells(s):
+    """A summary's stationarity signals, each 'mean +- standard error' or '-'."""
+    return ["{:+.3f} +- {:.3f}".format(s[k], s[k + "_err"]) if k in s and k + "_err" in s
+            else "-" for k in SIGNALS]
+
+
 def store(path):
     rows = []
     for point in rundir.Store(path).points():
         s, name = point.summary, point.path.name
         if "stationary" in s:
             verdict = "stationary" if s["stationary"] else "DRIFTING: " + s.get("not_stationary", "")
-            signals = " | ".join(
-                "{:+.3f} +- {:.3f}".format(s[k], s[k + "_err"]) if k in s and k + "_err" in s
-                else "-" for k in SIGNALS)
+            signals = " | ".join(signal_cells(s))
             rows.append((s.get("J", math.nan), name,
                          "| {:.4f} | {} | {}".format(s.get("phi", math.nan), signals, verdict)))
             continue
@@ -68,8 +72,7 @@ def markdown(paths):
             if "stationary" not in s:
                 without.append(f"{path}/{name}")
                 continue
-            cells = ["{:+.3f} +- {:.3f}".format(s[k], s[k + "_err"])
-                     if k in s and k + "_err" in s else "-" for k in SIGNALS]
+            cells = signal_cells(s)
             verdict = "stationary" if s["stationary"] else "drifting: " + s.get("not_stationary", "")
             rows.append((s.get("J", math.nan), name, "| {} | {} | {:.4f} | {} | {} |".format(
                 pathlib.PurePath(path).name, name, s.get("phi", math.nan), " | ".join(cells),
