@@ -543,12 +543,23 @@ void check_combinations(const Config& c, const std::string& origin) {
   check_spacing("output.checkpoint_strain", c.output.checkpoint_strain, "checkpoints");
 }
 
-// Whether the document (already parsed once without error) or an override sets scene.type.
-bool names_scene(const std::string& toml_text, const std::vector<std::string>& overrides) {
+// Whether the document or an override names `key` ("section.name").
+bool names_key(const toml::table& root, const std::vector<std::string>& overrides,
+               const std::string& key) {
   for (const auto& o : overrides)
-    if (o.rfind("scene.type=", 0) == 0) return true;
-  const toml::table root = toml::parse(toml_text);
-  return root["scene"]["type"].is_string();
+    if (o.rfind(key + "=", 0) == 0) return true;
+  const auto dot = key.find('.');
+  return static_cast<bool>(root[key.substr(0, dot)][key.substr(dot + 1)]);
+}
+
+// The defaults a config file takes from its scene, where they differ from Config's own (which a
+// record that does not name the key ran with, ConfigSource). Spheres slide with the capped
+// spring's stiffness across the stretch: at the sweep's step it is the law closer to a 3x finer
+// step, and it halves the low-J cost (docs/results-3d.md, "The sliding law").
+void apply_file_defaults(Config& c, const toml::table& root,
+                         const std::vector<std::string>& overrides) {
+  if (c.scene.dimension == 3 && !names_key(root, overrides, "contact.sliding_stiffness"))
+    c.contact.sliding_stiffness = "sideways";
 }
 
 }  // namespace
@@ -572,7 +583,7 @@ void resolve_defaults(Config& c) {
 }
 
 Config parse_config(const std::string& toml_text, const std::string& origin,
-                    const std::vector<std::string>& overrides) {
+                    const std::vector<std::string>& overrides, ConfigSource source) {
   Config cfg;
   toml::table root;
   try {
@@ -611,12 +622,14 @@ Config parse_config(const std::string& toml_text, const std::string& origin,
     }
     spec->set(cfg, convert(*t.get("v"), *spec, "--set"));
   }
+  if (source == ConfigSource::file) apply_file_defaults(cfg, root, overrides);
   resolve_defaults(cfg);
   check_combinations(cfg, origin);
   return cfg;
 }
 
-Config load_config(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+Config load_config(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                   ConfigSource source) {
   // A directory opens as an empty stream on Linux: it would run the defaults.
   std::error_code ec;
   const auto status = std::filesystem::status(file, ec);
@@ -638,10 +651,10 @@ Config load_config(const std::filesystem::path& file, const std::vector<std::str
     throw ConfigError(
         fmt::format("{}: cannot read the config file: {}", file.string(), std::strerror(errno)));
   const std::string text = ss.str();
-  Config cfg = parse_config(text, file.string(), overrides);
+  Config cfg = parse_config(text, file.string(), overrides, source);
   // An empty or truncated file would otherwise run the default scene: the scene is the one
   // key a config file must give.
-  if (!names_scene(text, overrides)) {
+  if (!names_key(toml::parse(text), overrides, "scene.type")) {
     const auto& scenes = scene_registry();
     std::string others;
     for (std::size_t k = 0; k + 1 < scenes.size(); ++k)
@@ -715,12 +728,31 @@ std::string to_toml(const Config& cfg) {
   return out;
 }
 
+namespace {
+
+// A config file's defaults for spheres, where the scene changes them (apply_file_defaults).
+Config sphere_file_defaults() {
+  Config c;
+  c.scene.dimension = 3;
+  apply_file_defaults(c, toml::table{}, {});
+  return c;
+}
+
+// The default for the reference: one value, or the discs' and the spheres' where they differ.
+std::string default_cell(const KeySpec& k, const Config& def, const Config& spheres) {
+  const std::string discs = default_text(k.get(def)), balls = default_text(k.get(spheres));
+  if (k.key == "scene.dimension" || discs == balls) return discs;
+  return fmt::format("{} (discs), {} (spheres)", discs, balls);
+}
+
+}  // namespace
+
 std::string config_reference_markdown() {
   std::ostringstream os;
   os << "| key | type | default | allowed | unit | meaning |\n|---|---|---|---|---|---|\n";
-  const Config def;
+  const Config def, spheres = sphere_file_defaults();
   for (const auto& k : schema())
-    os << "| `" << k.key << "` | " << type_name(k.kind) << " | " << default_text(k.get(def))
+    os << "| `" << k.key << "` | " << type_name(k.kind) << " | " << default_cell(k, def, spheres)
        << " | " << range_text(k) << " | " << (k.unit.empty() ? "-" : k.unit) << " | " << k.doc
        << " |\n";
   return os.str();
@@ -733,7 +765,7 @@ std::string config_reference_text(std::size_t width) {
       "key is optional). Units: docs/units.md. The same as a Markdown table: sheardiff "
       "config-doc --markdown (docs/config.md).",
       width, "# ");
-  const Config def;
+  const Config def, spheres = sphere_file_defaults();
   std::string section;
   for (const auto& k : schema()) {
     const auto [sec, name] = split_key(k.key);
@@ -745,6 +777,8 @@ std::string config_reference_text(std::size_t width) {
     out += wrap_text(
         fmt::format("allowed: {}{}", range_text(k), k.unit.empty() ? "" : "; unit: " + k.unit),
         width, "#   ");
+    if (const std::string cell = default_cell(k, def, spheres); cell != default_text(k.get(def)))
+      out += wrap_text("default: " + cell + "; the line below is the discs'", width, "#   ");
     out += name + " = " + toml_value(k.get(def)) + "\n";
   }
   return out;

@@ -67,7 +67,7 @@ std::vector<ConfigChange> changes_from(const std::filesystem::path& file,
                                        const std::string& resolved) {
   std::string was;
   try {
-    was = to_toml(load_config(file));
+    was = to_toml(load_config(file, {}, ConfigSource::record));
   } catch (const ConfigError& e) {
     return {{file.string(), "a configuration", fmt::format("unreadable ({})", e.what())}};
   }
@@ -88,7 +88,8 @@ std::string listed(const std::vector<ConfigChange>& changes, const std::filesyst
     // Only a key that resolve_defaults fills in (0 = derived) can follow from the others.
     bool derived = false;
     try {
-      const auto again = config_changes(to_toml(load_config(file, others)), "");
+      const auto again =
+          config_changes(to_toml(load_config(file, others, ConfigSource::record)), "");
       derived = !c.now.empty() && std::strtod(c.now.c_str(), nullptr) != 0.0 &&
                 std::any_of(again.begin(), again.end(), [&](const ConfigChange& a) {
                   return a.key == c.key && a.was == c.now;

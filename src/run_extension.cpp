@@ -103,7 +103,8 @@ bool only_moves_the_end(const std::vector<ConfigChange>& changes) {
 
 bool only_moves_the_end(const std::string& was, const std::string& now) {
   try {
-    return only_moves_the_end(config_changes(to_toml(parse_config(was, "checkpoint.bin")), now));
+    return only_moves_the_end(config_changes(
+        to_toml(parse_config(was, "checkpoint.bin", {}, ConfigSource::record)), now));
   } catch (const ConfigError&) {
     return false;
   }

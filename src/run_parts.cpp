@@ -38,7 +38,7 @@ namespace {
 bool same_config_text(const std::string& text, const std::string& resolved) {
   if (text == resolved) return true;
   try {
-    return to_toml(parse_config(text, "checkpoint.bin")) == resolved;
+    return to_toml(parse_config(text, "checkpoint.bin", {}, ConfigSource::record)) == resolved;
   } catch (const ConfigError&) {
     return false;
   }

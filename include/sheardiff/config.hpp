@@ -104,13 +104,23 @@ struct ConfigError : std::runtime_error {
 // (run.strain / output.frame_strain, run.strain / output.checkpoint_strain).
 inline constexpr double kMaxOutputsPerRun = 1e7;
 
+// Where a configuration's text comes from. `file`: a user's config file or a sweep's point, whose
+// unnamed keys take today's defaults, some of which depend on the scene (a config file of spheres
+// slides with contact.sliding_stiffness = "sideways"). `record`: what sheardiff wrote of a run
+// (DIR/config.toml, checkpoint.bin, a stored sweep point); it names every key it knew, and a key
+// it does not name was added since and takes the value that run ran with (Config's own default),
+// so that a record reads as the run it was.
+enum class ConfigSource { file, record };
+
 // Parse a TOML document (origin names it in errors) and apply "section.key=value" overrides.
 Config parse_config(const std::string& toml_text, const std::string& origin,
-                    const std::vector<std::string>& overrides = {});
+                    const std::vector<std::string>& overrides = {},
+                    ConfigSource source = ConfigSource::file);
 // A config file: parse_config, and further the file must be a regular file and must set
 // scene.type (an empty file is not a run of the default scene).
 Config load_config(const std::filesystem::path& file,
-                   const std::vector<std::string>& overrides = {});
+                   const std::vector<std::string>& overrides = {},
+                   ConfigSource source = ConfigSource::file);
 // Fills the defaults that depend on other keys (output.frame_strain = 0 -> from J). Done by
 // parse_config; call it on a Config built in code.
 void resolve_defaults(Config& cfg);

@@ -292,7 +292,8 @@ int analyse_command(const CommandLine& cl, std::optional<sheardiff::RunDirectory
     throw sheardiff::ConfigError(fmt::format(
         "{}: analyse needs a finished run (summary.json); this directory holds {}", run_dir,
         dir->state() == sheardiff::RunState::empty ? "no run" : "a run that has not finished"));
-  const auto run_cfg = sheardiff::load_config(dir->file("config.toml"));
+  const auto run_cfg =
+      sheardiff::load_config(dir->file("config.toml"), {}, sheardiff::ConfigSource::record);
   {
     // Read here so that a damaged summary is named (reanalyse_run would not name it).
     std::ifstream in(dir->file("summary.json"));

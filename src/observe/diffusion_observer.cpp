@@ -282,7 +282,7 @@ Reanalysis reanalyse_run(const std::filesystem::path& dir,
           "analyse --set {}: only analysis.* and observables.* keys change an analysis of the "
           "same frames; the others change the run (run it again)",
           o));
-  const Config cfg = load_config(dir / "config.toml", overrides);
+  const Config cfg = load_config(dir / "config.toml", overrides, ConfigSource::record);
   const nlohmann::json run = read_summary(dir);
   if (!scene_kind(cfg.scene.type).imposes_shear_rate())
     throw ConfigError(fmt::format(

@@ -632,7 +632,7 @@ struct Combination {
   void add(const fs::path& store, const std::string& store_name) {
     std::set<double> js_here;
     for (auto& [dir, summary] : store_summaries(store)) {
-      const Config cfg = load_config(dir / "config.toml");
+      const Config cfg = load_config(dir / "config.toml", {}, ConfigSource::record);
       const std::string id = group_identity(cfg);
       const std::string name =
           (store.filename().empty() ? store.parent_path().filename() : store.filename()).string() +

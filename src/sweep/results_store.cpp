@@ -34,7 +34,7 @@ fs::path stored_point(const SweepSpec& spec, const SweepPoint& p) {
   // for run directories): a changed sweep never silently reuses old results.
   std::string theirs;
   try {
-    theirs = to_toml(load_config(dir / "config.toml"));
+    theirs = to_toml(load_config(dir / "config.toml", {}, ConfigSource::record));
   } catch (const ConfigError&) {
     return {};
   }

@@ -336,7 +336,7 @@ PointState point_state(const SweepSpec& spec, const SweepPoint& p, const fs::pat
   // not make a finished point look foreign.
   std::string mine = to_toml(point_config(spec, p)), theirs;
   try {
-    theirs = to_toml(load_config(dir / "config.toml"));
+    theirs = to_toml(load_config(dir / "config.toml", {}, ConfigSource::record));
   } catch (const ConfigError&) {
   }
   if (mine != theirs) {

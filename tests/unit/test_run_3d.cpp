@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -183,6 +185,61 @@ TEST(SphereRun, ConfigurationSelectsTheSpheresAndTheirOwnChecks) {
   Config narrow = c;
   narrow.particles.n = 8;
   EXPECT_THROW(validate_run_inputs(narrow, "t.toml"), ConfigError);
+}
+
+// A config file of spheres that does not name contact.sliding_stiffness runs "sideways"; one of
+// discs (the same law either way) and a code-built Config keep "none". A run's record that does
+// not name the key was written before it existed and ran "none": it still reads as that run, so
+// a resume or an extension of it with "none" goes on, and one with the new default is refused
+// naming the key, never switched silently.
+TEST(SphereRun, AFileOfSpheresSlidesSidewaysAndARecordKeepsTheLawItRan) {
+  const std::string spheres = "[scene]\ntype = \"pressure_shear\"\ndimension = 3\n";
+  EXPECT_EQ(parse_config(spheres, "t.toml").contact.sliding_stiffness, "sideways");
+  EXPECT_EQ(
+      parse_config("[scene]\ntype = \"pressure_shear\"\n", "t.toml").contact.sliding_stiffness,
+      "none");
+  EXPECT_EQ(parse_config(spheres + "[contact]\nsliding_stiffness = \"none\"\n", "t.toml")
+                .contact.sliding_stiffness,
+            "none");
+  EXPECT_EQ(
+      parse_config(spheres, "t.toml", {"contact.sliding_stiffness=none"}).contact.sliding_stiffness,
+      "none");
+  // Discs given as spheres by an override take the spheres' default.
+  EXPECT_EQ(parse_config("[scene]\ntype = \"pressure_shear\"\n", "t.toml", {"scene.dimension=3"})
+                .contact.sliding_stiffness,
+            "sideways");
+  EXPECT_EQ(parse_config(spheres, "t.toml", {}, ConfigSource::record).contact.sliding_stiffness,
+            "none");
+
+  const fs::path dir = fs::temp_directory_path() / "sheardiff_test_sphere_record";
+  fs::remove_all(dir);
+  Config old = sphere_cell(0.6);
+  ASSERT_EQ(old.contact.sliding_stiffness, "none");
+  run_to_directory(old, dir, false);
+  // What a sheardiff older than the key wrote: the same record without its line.
+  std::string record;
+  {
+    std::ifstream in(dir / "config.toml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    record = ss.str();
+  }
+  const std::string line = "sliding_stiffness = \"none\"\n";
+  ASSERT_NE(record.find(line), std::string::npos);
+  record.erase(record.find(line), line.size());
+  std::ofstream(dir / "config.toml") << record;
+  Config switched = sphere_cell(0.7);
+  switched.contact.sliding_stiffness = "sideways";
+  try {
+    run_to_directory(switched, dir, false, true);
+    ADD_FAILURE() << "an extension with another sliding law was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("contact.sliding_stiffness"), std::string::npos)
+        << e.what();
+  }
+  const nlohmann::json extended = run_to_directory(sphere_cell(0.7), dir, false, true);
+  EXPECT_GE(extended[summary_key::strain].get<double>(), 0.7 - 1e-9);
+  fs::remove_all(dir);
 }
 
 TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {

@@ -10,9 +10,11 @@ struct ContactParams {
   double ktilde = 1e4;
   double kt_ratio = 0.5;
   double mu = 0.5;
-  std::string stiffness = "uniform";       // or "mean_radius" (kn, kt x (a_i + a_j) / d)
-  std::string stick_rule = "unloading";    // or "coulomb" (FrictionalContact::StickRule)
-  std::string sliding_stiffness = "none";  // or "sideways" (FrictionalContact::sideways)
+  std::string stiffness = "uniform";     // or "mean_radius" (kn, kt x (a_i + a_j) / d)
+  std::string stick_rule = "unloading";  // or "coulomb" (FrictionalContact::StickRule)
+  // Or "sideways" (FrictionalContact::sideways), a config file's default for spheres
+  // (ConfigSource).
+  std::string sliding_stiffness = "none";
 
   // Keys: the schema's section adapter (src/config.cpp), with real / boolean / choice.
   template <class Keys>
@@ -41,7 +43,9 @@ struct ContactParams {
              "friction force is explicit. `sideways`: across its stretch, kt times the ratio "
              "cap / |trial stretch| of its last Coulomb cap (the capped spring's tangent), so "
              "that the force turns with the slip within the step. Discs have no sideways "
-             "direction: for them the two are the same law.");
+             "direction: for them the two are the same law. Spheres default to `sideways`, the "
+             "law closer to a finer step (docs/results-3d.md, \"The sliding law\"); a run's "
+             "record (DIR/config.toml) that does not name the key predates it and ran `none`.");
   }
 };
 
