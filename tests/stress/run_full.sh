@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The full stress grid (issue 6, docs/stability.md): 6 J x 5 ktilde x dense/dilute x
-# implicit/heun x adaptive/fixed dt = 240 points, one at a time, each capped at CAP seconds.
+# The full stress grid (issue 6, docs/stability.md): discs/spheres x 6 J x 5 ktilde x
+# dense/dilute x implicit/heun x adaptive/fixed dt = 480 points, one at a time, each capped at
+# CAP seconds.
 #
 #   bash tests/stress/run_full.sh [BUILD_DIR] [CAP]      (defaults: build, 30)
 #

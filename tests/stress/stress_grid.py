@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Stress-test grid (issue 6): the built binary over J x ktilde x start x integrator x dt mode,
-small N and short strain, pressure-imposed plane shear (the scene with a wall pressure check).
+"""Stress-test grid (issue 6): the built binary over discs and spheres x J x ktilde x start x
+integrator x dt mode, small N and short strain, pressure-imposed plane shear (the scene with a
+wall pressure check).
 
 Each point ends in one of these categories:
   survived  exit 0 and every sanity check below holds;
@@ -14,8 +15,8 @@ Each point ends in one of these categories:
             step count not reached, or a NaN/Inf in summary.json or trajectory.h5;
   CRASH     any other exit (signal, 1, ...).
 SILENT and CRASH must not happen: the script exits 1 if any point falls in them, except
-SILENT points matching a line of --known FILE (regular expressions over "integrator=I dt=D
-problem=TEXT"): bugs already reported and waiting for a fix, shown as "known".
+SILENT points matching a line of --known FILE (regular expressions over "particles=P
+integrator=I dt=D problem=TEXT"): bugs already reported and waiting for a fix, shown as "known".
 
   stress_grid.py --bin build/sheardiff [--grid ci|full] [--cap 60] [--markdown FILE]
 """
@@ -31,40 +32,55 @@ import sys
 import tempfile
 import time
 
-N = 60
 STRAIN = 0.05
 MAX_STEPS = 3000
-STARTS = {"dense": 0.80, "dilute": 0.45}
+# Per dimension: the number of particles and the dense and dilute starts. Discs: 60, area
+# fractions 0.80 and 0.45. Spheres: 64 (a cell just wider than two neighbour cut-offs), volume
+# fractions 0.55 (the densest random start the scene builds: random addition, then compression
+# with overlap relaxation) and 0.30.
+CELLS = {2: {"N": 60, "key": "phi_init", "dense": 0.80, "dilute": 0.45},
+         3: {"N": 64, "key": "phi_init_spheres", "dense": 0.55, "dilute": 0.30}}
+STARTS = ("dense", "dilute")
+NAMES = {2: "discs", 3: "spheres"}
 
 
 def points(grid):
     js = [1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0]
     ks = [1e2, 1e3, 1e4, 1e5, 1e6]
-    full = list(itertools.product(js, ks, STARTS, ["implicit", "heun"], ["adaptive", "fixed"]))
+    full = list(itertools.product(CELLS, js, ks, STARTS, ["implicit", "heun"],
+                                  ["adaptive", "fixed"]))
     if grid == "full":
         return full
-    # CI: the corners of the grid, each integrator and dt mode at least once (< 60 s in all).
+    # CI: the corners of the grid, each integrator and dt mode at least once in each dimension
+    # (< 30 s in all).
     return [
-        (1e-4, 1e2, "dense", "implicit", "adaptive"),
-        (1e-1, 1e6, "dense", "implicit", "adaptive"),
-        (1.0, 1e3, "dilute", "implicit", "fixed"),
-        (1e-5, 1e4, "dense", "implicit", "fixed"),
-        (1e-2, 1e2, "dense", "heun", "adaptive"),
-        (1.0, 1e4, "dilute", "heun", "adaptive"),
-        (1e-2, 1e2, "dense", "heun", "fixed"),
-        (1e-3, 1e6, "dense", "heun", "fixed"),
+        (2, 1e-4, 1e2, "dense", "implicit", "adaptive"),
+        (2, 1e-1, 1e6, "dense", "implicit", "adaptive"),
+        (2, 1.0, 1e3, "dilute", "implicit", "fixed"),
+        (2, 1e-5, 1e4, "dense", "implicit", "fixed"),
+        (2, 1e-2, 1e2, "dense", "heun", "adaptive"),
+        (2, 1.0, 1e4, "dilute", "heun", "adaptive"),
+        (2, 1e-2, 1e2, "dense", "heun", "fixed"),
+        (2, 1e-3, 1e6, "dense", "heun", "fixed"),
+        (3, 1e-5, 1e4, "dense", "implicit", "adaptive"),
+        (3, 1e-1, 1e6, "dense", "implicit", "adaptive"),
+        (3, 1.0, 1e3, "dilute", "implicit", "fixed"),
+        (3, 1e-2, 1e2, "dense", "heun", "adaptive"),
+        (3, 1e-3, 1e6, "dense", "heun", "fixed"),
     ]
 
 
-def config_text(j, k, start, integ, mode):
+def config_text(dim, j, k, start, integ, mode):
     # A fixed dt is a strain step of 1e-3: fine for implicit springs, above the stability
     # limit of explicit ones at large ktilde (then the config must be rejected).
     dt = 1e-3 / j if mode == "fixed" else 0.0
+    cell = CELLS[dim]
     return f"""[scene]
 type = "pressure_shear"
+dimension = {dim}
 [particles]
-N = {N}
-phi_init = {STARTS[start]}
+N = {cell["N"]}
+{cell["key"]} = {cell[start]}
 [flow]
 J = {j!r}
 [contact]
@@ -143,12 +159,12 @@ def judge(out, args):
 
 
 def run_point(args, work, p):
-    j, k, start, integ, mode = p
-    name = f"J{j:g}_k{k:g}_{start}_{integ}_{mode}"
+    dim, j, k, start, integ, mode = p
+    name = f"{NAMES[dim]}_J{j:g}_k{k:g}_{start}_{integ}_{mode}"
     cfg = os.path.join(work, name + ".toml")
     out = os.path.join(work, name)
     with open(cfg, "w") as f:
-        f.write(config_text(j, k, start, integ, mode))
+        f.write(config_text(dim, j, k, start, integ, mode))
     t0 = time.monotonic()
     proc = subprocess.Popen([args.bin, "run", cfg, "--out", out], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
@@ -180,7 +196,7 @@ def run_point(args, work, p):
     else:
         cat, what = "CRASH", f"exit {rc}: {first_error}"
     shutil.rmtree(out, ignore_errors=True)
-    return {"J": j, "ktilde": k, "start": start, "integrator": integ, "dt": mode, "category": cat,
+    return {"particles": NAMES[dim], "J": j, "ktilde": k, "start": start, "integrator": integ, "dt": mode, "category": cat,
             "what": what, "seconds": secs, **nums}
 
 
@@ -209,11 +225,13 @@ def main():
         pts = points(args.grid)
         for i, p in enumerate(pts):
             r = run_point(args, work, p)
-            key = f"integrator={r['integrator']} dt={r['dt']} problem={r['what']}"
+            key = (f"particles={r['particles']} integrator={r['integrator']} dt={r['dt']} "
+                   f"problem={r['what']}")
             if r["category"] == "SILENT" and any(k.search(key) for k in known):
                 r["category"] = "known"
             results.append(r)
-            print(f"[{i + 1}/{len(pts)}] {r['category']:9s} {r['seconds']:6.1f}s J={r['J']:g} "
+            print(f"[{i + 1}/{len(pts)}] {r['category']:9s} {r['seconds']:6.1f}s "
+                  f"{r['particles']:7s} J={r['J']:g} "
                   f"k={r['ktilde']:g} {r['start']:6s} {r['integrator']:8s} {r['dt']:8s} "
                   f"overlap={fmt_num(r.get('overlap'))} res={fmt_num(r.get('residual'))} "
                   f"perr={fmt_num(r.get('perr'))} {r['what'][:160]}", flush=True)
@@ -228,14 +246,14 @@ def main():
             json.dump(results, f, indent=1)
     if args.markdown:
         with open(args.markdown, "w") as f:
-            f.write("| J | ktilde | start | integrator | dt | result | max overlap (d) | "
-                    "residual | wall pressure error | steps | s | detail |\n"
-                    "|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+            f.write("| particles | J | ktilde | start | integrator | dt | result | "
+                    "max overlap (d) | residual | wall pressure error | steps | s | detail |\n"
+                    "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
             for r in results:
                 detail = r["what"].replace("|", "/")
                 if len(detail) > 140:
                     detail = detail[:140] + "..."
-                f.write(f"| {r['J']:g} | {r['ktilde']:g} | {r['start']} | {r['integrator']} | "
+                f.write(f"| {r['particles']} | {r['J']:g} | {r['ktilde']:g} | {r['start']} | {r['integrator']} | "
                         f"{r['dt']} | {r['category']} | {fmt_num(r.get('overlap'))} | "
                         f"{fmt_num(r.get('residual'))} | {fmt_num(r.get('perr'))} | "
                         f"{r.get('steps', '-')} | {r['seconds']:.1f} | {detail} |\n")
