@@ -216,8 +216,8 @@ Origin check_directory(RunDirectory& dir, RunMode mode, const Config& cfg,
       throw ConfigError(fmt::format(
           "--resume {}: the configuration differs from the one the run was started with ({}; "
           "see {}/config.toml). Only a further end may be given to a run: a larger run.strain "
-          "or steady.measure_strain, a larger run.max_steps or 0",
-          out, listed(changes, dir.file(kConfigFile)), out));
+          "or steady.measure_strain, a larger run.max_steps or 0{}",
+          out, listed(changes, dir.file(kConfigFile)), out, changed_default_hint(changes)));
   }
   if (state == RunState::interrupted) return Origin::checkpoint;
   if (state != RunState::finished) return Origin::fresh;

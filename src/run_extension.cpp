@@ -88,6 +88,15 @@ std::string describe(const ConfigChange& c) {
                      c.now.empty() ? "not set" : c.now);
 }
 
+std::string changed_default_hint(const std::vector<ConfigChange>& changes) {
+  for (const auto& c : changes)
+    if (c.key == "contact.sliding_stiffness" && c.was == "\"none\"" && c.now == "\"sideways\"")
+      return ". A config file of spheres that does not name contact.sliding_stiffness runs "
+             "\"sideways\"; a run an earlier sheardiff started from such a file ran \"none\": "
+             "name it (--set contact.sliding_stiffness=none) to continue that run";
+  return "";
+}
+
 bool only_moves_the_end(const std::vector<ConfigChange>& changes) {
   if (changes.empty()) return false;
   for (const auto& c : changes) {

@@ -21,6 +21,10 @@ struct ConfigChange {
 std::vector<ConfigChange> config_changes(const std::string& was, const std::string& now);
 // "key: was -> now" for messages.
 std::string describe(const ConfigChange& c);
+// For a refusal over these changes: how to keep a run's value of a key whose default changed
+// under existing runs (contact.sliding_stiffness for spheres, ConfigSource), starting with
+// ". "; "" when no such key changed.
+std::string changed_default_hint(const std::vector<ConfigChange>& changes);
 
 // Whether every change moves the run's end further and nothing else: run.strain or
 // steady.measure_strain larger, run.max_steps larger or 0 (no cap). A run continued under such

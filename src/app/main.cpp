@@ -373,13 +373,21 @@ void refuse_foreign_folder(const std::filesystem::path& out) {
 
 // `sheardiff check CONFIG` and `sheardiff run CONFIG`.
 int config_command(CommandLine& cl, std::optional<sheardiff::RunDirectory>& dir) {
-  const sheardiff::Config cfg = sheardiff::load_config(cl.config_path, cl.overrides);
+  const bool resume = !cl.check->parsed() && !cl.resume_dir.empty();
+  // `run DIR/config.toml --resume DIR` gives the run's own record: it reads as the run it was.
+  std::error_code record_ec;
+  const bool own_record =
+      resume &&
+      std::filesystem::equivalent(cl.config_path,
+                                  std::filesystem::path(cl.resume_dir) / "config.toml", record_ec);
+  const sheardiff::Config cfg = sheardiff::load_config(
+      cl.config_path, cl.overrides,
+      own_record ? sheardiff::ConfigSource::record : sheardiff::ConfigSource::file);
   sheardiff::validate_run_inputs(cfg, cl.config_path);
   if (cl.check->parsed()) {
     std::cout << sheardiff::to_toml(cfg);
     return 0;
   }
-  const bool resume = !cl.resume_dir.empty();
   if (resume) cl.out_dir = cl.resume_dir;
   using sheardiff::RunMode;
   const RunMode mode = resume         ? RunMode::resume

@@ -2,6 +2,7 @@
 // spec.results/points/<name>/, so that a sweep spread over sessions, machines or a cluster is
 // continued and re-fitted from these files alone (docs/sweeps.md, "Results that persist").
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <fstream>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include "sheardiff/config.hpp"
 #include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/run_files.hpp"
+#include "sheardiff/run_extension.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {
@@ -38,11 +40,17 @@ fs::path stored_point(const SweepSpec& spec, const SweepPoint& p) {
   } catch (const ConfigError&) {
     return {};
   }
-  if (theirs != to_toml(load_config(spec.base, p.overrides)))
+  const std::string mine = to_toml(load_config(spec.base, p.overrides));
+  if (theirs != mine) {
+    std::vector<std::string> keys;
+    const auto changes = config_changes(theirs, mine);
+    for (const auto& c : changes) keys.push_back(describe(c));
     throw ConfigError(fmt::format(
-        "{} holds results of another configuration than sweep point {} (sweep file or base "
-        "config changed?); move them away or name another sweep.results",
-        dir.string(), p.name));
+        "{} holds results of another configuration than sweep point {} ({}; sweep file or base "
+        "config changed?); move them away or name another sweep.results{}",
+        dir.string(), p.name, fmt::format("{}", fmt::join(keys, "; ")),
+        changed_default_hint(changes)));
+  }
   return dir;
 }
 

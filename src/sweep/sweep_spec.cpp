@@ -1,5 +1,6 @@
 // The sweep file, its points and the state of each point's run directory.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/run_extension.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
 namespace sheardiff {
@@ -342,10 +344,15 @@ PointState point_state(const SweepSpec& spec, const SweepPoint& p, const fs::pat
   if (mine != theirs) {
     if (!fs::exists(dir / "summary.json") && !fs::exists(dir / "checkpoint.bin"))
       return PointState::fresh;  // an unfinished start with nothing to keep: redo it
+    std::vector<std::string> keys;
+    const auto changes = config_changes(theirs, mine);
+    for (const auto& c : changes) keys.push_back(describe(c));
     throw ConfigError(fmt::format(
-        "{} holds a run of another configuration than sweep point {} (sweep file or base config "
-        "changed?); move it away or sweep into another --out",
-        dir.string(), p.name));
+        "{} holds a run of another configuration than sweep point {} ({}; sweep file or base "
+        "config changed?); move it away or sweep into another --out{}",
+        dir.string(), p.name,
+        keys.empty() ? "unreadable" : fmt::format("{}", fmt::join(keys, "; ")),
+        changed_default_hint(changes)));
   }
   if (fs::exists(dir / "summary.json")) return PointState::finished;
   if (fs::exists(dir / "checkpoint.bin")) return PointState::resumable;

@@ -86,4 +86,36 @@ mkdir empty
 expect 2 "--resume empty: there is no run there to resume" -- run run.toml --resume empty
 expect 2 "nope: no such directory" -- run run.toml --resume nope
 [ -e nope ] && fail "--resume created a directory"
-echo "run_dir_protect: finished and interrupted runs refused untouched; --overwrite left no stale file; --resume continued or restarted"
+# A run of spheres recorded by a sheardiff older than contact.sliding_stiffness (its config.toml
+# does not name the key) ran "none", which a file of spheres no longer defaults to. Its own
+# record given back (`run DIR/config.toml --resume DIR`) extends it as the run it was; the
+# user's file that does not name the key is refused, naming the key and how to keep "none".
+cat > spheres.toml <<'TOML'
+[scene]
+type = "pressure_shear"
+dimension = 3
+[particles]
+N = 64
+phi_init_spheres = 0.5
+[flow]
+J = 0.03
+[contact]
+ktilde = 1e3
+[run]
+strain = 0.1
+[steady]
+window = 0.05
+[analysis]
+diffusion = false
+[output]
+trajectory = false
+TOML
+"$bin" run spheres.toml --out old --set contact.sliding_stiffness=none > /dev/null 2>&1 || fail "spheres run"
+grep -q '^sliding_stiffness = "none"$' old/config.toml || fail "the record does not name the law"
+sed -i '/^sliding_stiffness = /d' old/config.toml
+expect 2 "contact.sliding_stiffness: \"none\" -> \"sideways\"" -- run spheres.toml --resume old --set run.strain=0.15
+grep -qF -- "--set contact.sliding_stiffness=none" cmd.err || fail "no hint to keep the law: $(cat cmd.err)"
+expect 0 "" -- run old/config.toml --resume old --set run.strain=0.15
+grep -qF '"strain": 0.15' old/summary.json || fail "the record's extension did not reach strain 0.15"
+expect 0 "" -- run spheres.toml --resume old --set run.strain=0.2 --set contact.sliding_stiffness=none
+echo "run_dir_protect: finished and interrupted runs refused untouched; --overwrite left no stale file; --resume continued or restarted; a pre-key record of spheres continued as it ran"
