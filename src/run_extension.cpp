@@ -88,6 +88,12 @@ std::string describe(const ConfigChange& c) {
                      c.now.empty() ? "not set" : c.now);
 }
 
+std::string describe(const std::vector<ConfigChange>& changes) {
+  std::string out;
+  for (const auto& c : changes) out += (out.empty() ? "" : "; ") + describe(c);
+  return out;
+}
+
 std::string changed_default_hint(const std::vector<ConfigChange>& changes) {
   for (const auto& c : changes)
     if (c.key == "contact.sliding_stiffness" && c.was == "\"none\"" && c.now == "\"sideways\"")

@@ -21,6 +21,8 @@ struct ConfigChange {
 std::vector<ConfigChange> config_changes(const std::string& was, const std::string& now);
 // "key: was -> now" for messages.
 std::string describe(const ConfigChange& c);
+// Every change described, joined by "; ".
+std::string describe(const std::vector<ConfigChange>& changes);
 // For a refusal over these changes: how to keep a run's value of a key whose default changed
 // under existing runs (contact.sliding_stiffness for spheres, ConfigSource), starting with
 // ". "; "" when no such key changed.

@@ -2,7 +2,6 @@
 // spec.results/points/<name>/, so that a sweep spread over sessions, machines or a cluster is
 // continued and re-fitted from these files alone (docs/sweeps.md, "Results that persist").
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include <fstream>
 #include <sstream>
@@ -42,14 +41,11 @@ fs::path stored_point(const SweepSpec& spec, const SweepPoint& p) {
   }
   const std::string mine = to_toml(load_config(spec.base, p.overrides));
   if (theirs != mine) {
-    std::vector<std::string> keys;
     const auto changes = config_changes(theirs, mine);
-    for (const auto& c : changes) keys.push_back(describe(c));
     throw ConfigError(fmt::format(
         "{} holds results of another configuration than sweep point {} ({}; sweep file or base "
         "config changed?); move them away or name another sweep.results{}",
-        dir.string(), p.name, fmt::format("{}", fmt::join(keys, "; ")),
-        changed_default_hint(changes)));
+        dir.string(), p.name, describe(changes), changed_default_hint(changes)));
   }
   return dir;
 }

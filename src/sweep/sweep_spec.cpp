@@ -344,14 +344,12 @@ PointState point_state(const SweepSpec& spec, const SweepPoint& p, const fs::pat
   if (mine != theirs) {
     if (!fs::exists(dir / "summary.json") && !fs::exists(dir / "checkpoint.bin"))
       return PointState::fresh;  // an unfinished start with nothing to keep: redo it
-    std::vector<std::string> keys;
-    const auto changes = config_changes(theirs, mine);
-    for (const auto& c : changes) keys.push_back(describe(c));
+    const auto changes =
+        theirs.empty() ? std::vector<ConfigChange>{} : config_changes(theirs, mine);
     throw ConfigError(fmt::format(
         "{} holds a run of another configuration than sweep point {} ({}; sweep file or base "
         "config changed?); move it away or sweep into another --out{}",
-        dir.string(), p.name,
-        keys.empty() ? "unreadable" : fmt::format("{}", fmt::join(keys, "; ")),
+        dir.string(), p.name, theirs.empty() ? "its config.toml does not parse" : describe(changes),
         changed_default_hint(changes)));
   }
   if (fs::exists(dir / "summary.json")) return PointState::finished;
