@@ -552,17 +552,28 @@ bool names_key(const toml::table& root, const std::vector<std::string>& override
   return static_cast<bool>(root[key.substr(0, dot)][key.substr(dot + 1)]);
 }
 
-// The defaults a config file takes from its scene, where they differ from Config's own (which a
-// record that does not name the key ran with, ConfigSource). Spheres slide with the capped
-// spring's stiffness across the stretch: at the sweep's step it is the law closer to a 3x finer
-// step, and it halves the low-J cost (docs/results-3d.md, "The sliding law").
+// The defaults of file_defaults() that apply to `c`, where the document and the overrides do not
+// name their key.
 void apply_file_defaults(Config& c, const toml::table& root,
                          const std::vector<std::string>& overrides) {
-  if (c.scene.dimension == 3 && !names_key(root, overrides, "contact.sliding_stiffness"))
-    c.contact.sliding_stiffness = "sideways";
+  for (const auto& d : file_defaults()) {
+    if (!d.applies(c) || names_key(root, overrides, d.key)) continue;
+    const KeySpec& spec = *find_spec(d.key);
+    spec.set(c, convert(*toml::parse("v = " + d.file_value).get("v"), spec, "file default"));
+  }
 }
 
 }  // namespace
+
+const std::vector<FileDefault>& file_defaults() {
+  // Spheres slide with the capped spring's stiffness across the stretch: at the sweep's step it
+  // is the law closer to a 3x finer step, and it halves the low-J cost (docs/results-3d.md,
+  // "The sliding law"). Runs of spheres before this default ran "none".
+  static const std::vector<FileDefault> table{
+      {"contact.sliding_stiffness", "spheres",
+       [](const Config& c) { return c.scene.dimension == 3; }, "\"sideways\"", "\"none\""}};
+  return table;
+}
 
 double overlap_change_limit(const Config& c) {
   if (c.integrator.max_overlap_change > 0.0) return c.integrator.max_overlap_change;

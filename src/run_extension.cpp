@@ -95,11 +95,16 @@ std::string describe(const std::vector<ConfigChange>& changes) {
 }
 
 std::string changed_default_hint(const std::vector<ConfigChange>& changes) {
+  const auto bare = [](const std::string& v) {  // a TOML string as --set takes it
+    return v.size() >= 2 && v.front() == '"' && v.back() == '"' ? v.substr(1, v.size() - 2) : v;
+  };
   for (const auto& c : changes)
-    if (c.key == "contact.sliding_stiffness" && c.was == "\"none\"" && c.now == "\"sideways\"")
-      return ". A config file of spheres that does not name contact.sliding_stiffness runs "
-             "\"sideways\"; a run an earlier sheardiff started from such a file ran \"none\": "
-             "name it (--set contact.sliding_stiffness=none) to continue that run";
+    for (const auto& d : file_defaults())
+      if (c.key == d.key && c.was == d.record_value && c.now == d.file_value)
+        return fmt::format(
+            ". A config file of {0} that does not name {1} runs {2}; a run an earlier sheardiff "
+            "started from such a file ran {3}: name it (--set {1}={4}) to continue that run",
+            d.scenes, d.key, d.file_value, d.record_value, bare(d.record_value));
   return "";
 }
 

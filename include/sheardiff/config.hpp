@@ -112,6 +112,19 @@ inline constexpr double kMaxOutputsPerRun = 1e7;
 // so that a record reads as the run it was.
 enum class ConfigSource { file, record };
 
+// A default that a config file and a record resolve differently (ConfigSource): a file of the
+// scenes where `applies` holds that does not name `key` takes `file_value`; a record that does
+// not name it ran with `record_value`, Config's own default. Values as to_toml writes them
+// ("\"none\"" for a string). `scenes` names those scenes in messages ("spheres").
+struct FileDefault {
+  std::string key, scenes;
+  bool (*applies)(const Config&);
+  std::string file_value, record_value;
+};
+// Every such default: the one table that parsing a file and the refusals over a changed default
+// read (changed_default_hint).
+const std::vector<FileDefault>& file_defaults();
+
 // Parse a TOML document (origin names it in errors) and apply "section.key=value" overrides.
 Config parse_config(const std::string& toml_text, const std::string& origin,
                     const std::vector<std::string>& overrides = {},

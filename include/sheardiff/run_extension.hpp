@@ -24,8 +24,8 @@ std::string describe(const ConfigChange& c);
 // Every change described, joined by "; ".
 std::string describe(const std::vector<ConfigChange>& changes);
 // For a refusal over these changes: how to keep a run's value of a key whose default changed
-// under existing runs (contact.sliding_stiffness for spheres, ConfigSource), starting with
-// ". "; "" when no such key changed.
+// under existing runs (a change from a file_defaults() entry's record value to its file value),
+// starting with ". "; "" when no such key changed.
 std::string changed_default_hint(const std::vector<ConfigChange>& changes);
 
 // Whether every change moves the run's end further and nothing else: run.strain or

@@ -10,6 +10,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/run.hpp"
+#include "sheardiff/run_extension.hpp"
 
 namespace sheardiff {
 namespace {
@@ -431,6 +432,45 @@ TEST(Config, NextOutputStrainEndsForAnySpacing) {
   EXPECT_GT(next_output_strain(1e-300, 1e-300, 1.0), 1.0);
   EXPECT_GT(next_output_strain(0.5, 1e-20, 1.0), 1.0);
   EXPECT_LT(next_output_strain(0.5, 1e-20, 1.0), 1.0 + 1e-11);
+}
+
+}  // namespace
+}  // namespace sheardiff
+
+namespace sheardiff {
+namespace {
+
+// Each default a config file and a record resolve differently (file_defaults): a record that
+// does not name the key reads as Config's own value, the one a run from before the default ran
+// with; a file of those scenes takes the new one; and a refusal over exactly that change says
+// how to keep the record's value. A table entry whose record value is not Config's default
+// would make every old run's record read as another run.
+TEST(Config, AFileDefaultDiffersFromTheRecordsAndTheRefusalSaysHowToKeepIt) {
+  const std::string spheres = "[scene]\ntype = \"pressure_shear\"\ndimension = 3\n";
+  const Config as_file = parse_config(spheres, "t.toml");
+  const Config as_record = parse_config(spheres, "t.toml", {}, ConfigSource::record);
+  ASSERT_FALSE(file_defaults().empty());
+  for (const auto& d : file_defaults()) {
+    ASSERT_TRUE(d.applies(as_file)) << d.key << ": give this test a config of " << d.scenes;
+    bool found = false;
+    const auto changes = config_changes(to_toml(as_record), to_toml(as_file));
+    for (const auto& c : changes)
+      if (c.key == d.key) {
+        found = true;
+        EXPECT_EQ(c.was, d.record_value);
+        EXPECT_EQ(c.now, d.file_value);
+      }
+    EXPECT_TRUE(found) << d.key << " reads the same in a file and a record";
+    const std::string hint = changed_default_hint(changes);
+    EXPECT_NE(hint.find(d.key), std::string::npos) << hint;
+    EXPECT_NE(hint.find(d.scenes), std::string::npos) << hint;
+    EXPECT_NE(hint.find("--set " + d.key + "="), std::string::npos) << hint;
+    // The other way round (a run of the new default continued with the old) is not this case.
+    EXPECT_EQ(changed_default_hint({{d.key, d.file_value, d.record_value}}), "");
+  }
+  EXPECT_NE(changed_default_hint(config_changes(to_toml(as_record), to_toml(as_file)))
+                .find("--set contact.sliding_stiffness=none)"),
+            std::string::npos);
 }
 
 }  // namespace
