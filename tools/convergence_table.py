@@ -40,7 +40,11 @@ docs/performance.md "Matched trajectory error"): q(h0) - q(0) = (q(h) - q(h0)) h
 +- the combined standard error times |h0 / (h - h0)|, and r = that bias over the reference's
 standard error. h0 is the reference's integrator.max_displacement, read from its points'
 config.toml when the reference comes from another sweep. From a step three times coarser the
-bias is half the shift.
+bias is half the shift. With two or more other steps, a last row fits the straight line
+q(h) = q(0) + c h through every step's mean (the reference's included), weighted by their
+standard errors, and gives its c h0 +- its standard error, r, and the line's chi2 (one degree of
+freedom for three steps: a chi2 well above it says the error is not first order over those
+steps). The steps' points are separate runs, so the fit has no shared reference to correct for.
 """
 import argparse
 import math
@@ -291,6 +295,34 @@ def first_order(a, axis, ref_value, ref_group, groups, quantities, stats, ref):
             err = math.hypot(e or 0.0, re) * abs(factor)
             cells.append(f"{bias:+.2g} +- {err:.2g} (r {bias / re:+.1f})")
         print(f"| {h:g} | " + " | ".join(cells) + " |")
+    steps = [h for h in groups if h != h0]
+    if len(steps) < 2:
+        return
+    cells = []
+    for q, _ in quantities:
+        pts = [(h, *stats(groups[h], q)) for h in steps] + [(h0, *ref[q])]
+        if any(m is None or not e for _, m, e in pts):
+            cells.append("-")
+            continue
+        c, var_c, chi2 = weighted_line(pts)
+        bias = c * h0 + 0.0
+        cells.append(f"{bias:+.2g} +- {math.sqrt(var_c) * h0:.2g} (chi2 {chi2:.2g}, "
+                     f"r {bias / ref[q][1]:+.1f})")
+    print("| all steps, a line | " + " | ".join(cells) + " |")
+
+
+def weighted_line(pts):
+    """Slope, its variance and chi2 of the line through (h, mean, standard error) points."""
+    w = [1.0 / (e * e) for _, _, e in pts]
+    s, sx = sum(w), sum(wi * h for wi, (h, _, _) in zip(w, pts))
+    sxx = sum(wi * h * h for wi, (h, _, _) in zip(w, pts))
+    sy = sum(wi * m for wi, (_, m, _) in zip(w, pts))
+    sxy = sum(wi * h * m for wi, (h, m, _) in zip(w, pts))
+    det = s * sxx - sx * sx
+    c = (s * sxy - sx * sy) / det
+    q0 = (sxx * sy - sx * sxy) / det
+    chi2 = sum(wi * (m - q0 - c * h) ** 2 for wi, (h, m, _) in zip(w, pts))
+    return c, s / det, chi2
 
 if __name__ == "__main__":
     main()

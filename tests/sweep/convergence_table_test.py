@@ -53,6 +53,14 @@ assert row[3].endswith("(r +2.0)") and row[1] == "-", row
 row = [c.strip() for c in next(l for l in est if l.startswith("| 0.0003 |")).strip("|").split("|")]
 assert row[3].endswith("(r +0.0)"), row
 assert not any(l.startswith("| 0.001 |") for l in est), "the reference's own row has no estimate"
+# The line through the three steps (equal errors; h = 0.3, 1, 3 in units of 1e-3, dv = 0, 0, 4 in
+# reference errors): slope 6.2667 / 3.9267 = 1.596 errors per 1e-3, so the reference's bias is
+# r = +1.6, +- 1 / sqrt(3.9267) = 0.50 errors, and chi2 = 0.67 about the line.
+row = [c.strip() for c in next(l for l in est if l.startswith("| all steps, a line |"))
+       .strip("|").split("|")]
+assert row[3].endswith("(chi2 0.67, r +1.6)") and row[1] == "-", row
+bias, err = (float(x) for x in row[3].split(" (")[0].split(" +- "))
+assert abs(err / bias - 0.505 / 1.596) < 0.02, row
 # Its reference step from another sweep's points' config.toml (a sweep over seeds at md = 1e-3).
 seeds_md = work / "seeds_md"
 (seeds_md / "points").mkdir(parents=True, exist_ok=True)
