@@ -71,17 +71,6 @@ def quantity(r, q):
     return None if r.get(rundir.key(q)) in (None, "") else float(r[q])
 
 
-def mean_sem(xs):
-    n = len(xs)
-    if n == 0:
-        return None, None
-    m = sum(xs) / n
-    if n < 2:
-        return m, None
-    var = sum((x - m) ** 2 for x in xs) / (n - 1)
-    return m, math.sqrt(var / n)
-
-
 def g(x, p=3):
     return "-" if x is None else f"{x:.{p}g}"
 
@@ -208,7 +197,7 @@ def main():
                   else QUANTITIES)
 
     def stats(rs, q):
-        m, e = mean_sem([x for x in (quantity(r, q) for r in rs) if x is not None])
+        m, e = rundir.mean_sem([x for x in (quantity(r, q) for r in rs) if x is not None])
         errs = [float(r[q + "_err"]) for r in rs if r.get(q + "_err") not in (None, "")]
         if m is not None and errs and len(errs) == len(rs):
             own = math.sqrt(sum(x * x for x in errs) / len(errs)) / math.sqrt(len(errs))
@@ -246,7 +235,7 @@ def main():
                 cell += f" ({(m - rm) / comb:+.1f}, {(m - rm) / re:+.1f})"
             cells.append(cell)
         steps, _ = stats(rs, "steps_per_strain")
-        secs = mean_sem([float(r["wall_seconds"]) / float(r["strain"]) for r in rs
+        secs = rundir.mean_sem([float(r["wall_seconds"]) / float(r["strain"]) for r in rs
                          if r.get("wall_seconds") and r.get("strain")])[0]
         print(f"| {label} | {len(rs)} | " + " | ".join(cells) + f" | {g(steps)} | {g(secs)} |")
     if a.first_order:

@@ -454,21 +454,11 @@ def cost(done):
     print("|---|---|---|---|---|---|")
     for j in sorted(k for k in by_j if k is not None):
         rs = by_j[j]
-        vals = [mean_sem([cell(r, k) for r in rs])[0]
+        vals = [rundir.mean_sem([cell(r, k) for r in rs])[0]
                 for k in ("steps_per_strain", "ms_per_step", "strain", "wall_seconds")]
         v = [x if x is not None else float("nan") for x in vals]
         print(f"| {j:g} | {len(rs)} | {v[0]:.0f} | {v[1]:.1f} | {v[2]:.1f} | {v[3] / 3600:.2f} |")
     print()
-
-
-def mean_sem(v):
-    v = [x for x in v if x is not None and math.isfinite(x)]
-    if not v:
-        return None, None
-    m = sum(v) / len(v)
-    if len(v) < 2:
-        return m, None
-    return m, math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v))
 
 
 def causes(done):
@@ -487,13 +477,13 @@ def causes(done):
         rs = by_j[j]
         cells = []
         for num_k, den_k in (("D_bulk", "D"), ("dv_bulk", "dv"), ("psi_bulk", "psi")):
-            cells.append(mean_sem([cell(r, num_k) / cell(r, den_k) if cell(r, num_k) and cell(r, den_k)
+            cells.append(rundir.mean_sem([cell(r, num_k) / cell(r, den_k) if cell(r, num_k) and cell(r, den_k)
                                    else None for r in rs]))
-        cells.append(mean_sem([cell(r, "bulk_shear_rate_ratio") for r in rs]))
-        cells.append(mean_sem([cell(r, "mu_top") - cell(r, "mu_bottom") if cell(r, "mu_top") is not None
+        cells.append(rundir.mean_sem([cell(r, "bulk_shear_rate_ratio") for r in rs]))
+        cells.append(rundir.mean_sem([cell(r, "mu_top") - cell(r, "mu_bottom") if cell(r, "mu_top") is not None
                                and cell(r, "mu_bottom") is not None else None for r in rs]))
         for key in ("psi", "psi_e", "psi_full", "psi_zero"):
-            cells.append(mean_sem([cell(r, "D") / (cell(r, "dv") ** 2 * cell(r, key))
+            cells.append(rundir.mean_sem([cell(r, "D") / (cell(r, "dv") ** 2 * cell(r, key))
                                    if cell(r, "D") and cell(r, "dv") and cell(r, key) else None
                                    for r in rs]))
         print(f"| {j:g} | " + " | ".join(pm(m, e) for m, e in cells) + " |")

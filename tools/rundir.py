@@ -18,6 +18,7 @@ run flushes it every two seconds).
     store.rows()       # sweep.csv as dicts; store.fits: fits.json
 """
 import json
+import math
 import pathlib
 import re
 import tomllib
@@ -127,6 +128,18 @@ NOT_STATIONARY = ("done, not stationary", "done, drifting (mu_top - mu_bottom)")
 
 def is_stationary(row):
     return row["status"] == STATIONARY
+
+
+def mean_sem(values):
+    """(mean, standard error of the mean from the values' scatter) of the finite values; the
+    error is None below two values, both are None for none."""
+    v = [x for x in values if x is not None and math.isfinite(x)]
+    if not v:
+        return None, None
+    m = sum(v) / len(v)
+    if len(v) < 2:
+        return m, None
+    return m, math.sqrt(sum((x - m) ** 2 for x in v) / (len(v) - 1) / len(v))
 
 
 class Store:
