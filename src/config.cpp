@@ -558,8 +558,9 @@ void apply_file_defaults(Config& c, const toml::table& root,
                          const std::vector<std::string>& overrides) {
   for (const auto& d : file_defaults()) {
     if (!d.applies(c) || names_key(root, overrides, d.key)) continue;
-    const KeySpec& spec = *find_spec(d.key);
-    spec.set(c, convert(*toml::parse("v = " + d.file_value).get("v"), spec, "file default"));
+    const KeySpec* spec = find_spec(d.key);
+    if (!spec) throw std::logic_error("file_defaults(): no key " + d.key);
+    spec->set(c, convert(*toml::parse("v = " + d.file_value).get("v"), *spec, "file default"));
   }
 }
 
