@@ -197,7 +197,7 @@ def main():
                   else QUANTITIES)
 
     def stats(rs, q):
-        m, e = rundir.mean_sem([x for x in (quantity(r, q) for r in rs) if x is not None])
+        m, e = rundir.mean_sem(quantity(r, q) for r in rs)
         errs = [float(r[q + "_err"]) for r in rs if r.get(q + "_err") not in (None, "")]
         if m is not None and errs and len(errs) == len(rs):
             own = math.sqrt(sum(x * x for x in errs) / len(errs)) / math.sqrt(len(errs))
