@@ -1,0 +1,134 @@
+#!/usr/bin/python3
+"""The shear stress of the pressure cell's bulk against the walls' mu, and both against Boyer,
+Guazzelli & Pouliquen (2011), from the stored points' summaries (profiles included).
+
+The one-body Stokes drag acts against the imposed flow gammadot (y - y_b) (docs/model.md
+section 3), so wherever the particles' mean velocity u_x(y) departs from it the drag adds a force
+density f_x(y) = n(y) 3 pi eta d (gammadot (y - y_b) - u_x(y)) along x, and the shear stress is
+not the same at every height: x momentum balance of the slab between the bottom wall and y gives
+
+    sigma_xy(y) = mu_bottom P - int_0^y f_x dy'     (and from the top: mu_top P + int_y^H f_x dy').
+
+For each point this prints, averaged over the bulk band (the profile bins at least
+`observables.wall_exclusion` from both wall lines, as phi):
+
+  * sigma_xy / P of the pair forces (profile_shear_stress, docs/model.md section 9);
+  * mu plus the drag between the walls and the band: the equation above, with n(y) 3 pi eta d from
+    each bin's volume fraction (the species mixed as `particles.mix` says, in every bin alike) and
+    u_x(y) the bin's mean over the particles centred in it; the mean of the two walls' values.
+
+The two are independent measurements of one stress: the first from the pair forces, the second
+from the wall forces and the velocity profile. Per J: the mean over the stationary points (+- the
+standard error of the seeds' scatter), with Boyer et al.'s mu(J) and that fit less its J term (the
+suspending fluid's own stress eta gammadot, which no force of this model carries) for spheres.
+
+    /usr/bin/python3 tools/wall_stress.py STORE [STORE ...]     # e.g. results/sweep_3d_j01 results/sweep_3d
+    /usr/bin/python3 tools/wall_stress.py --points STORE ...    # one row per point as well
+"""
+import argparse
+import math
+import pathlib
+import sys
+
+import rundir
+from results_table import BOYER_LAWS, pm
+
+
+def drag_coefficient(cfg):
+    """n 3 pi eta d per unit volume fraction (eta = 1, in P / (gammadot d) per d): the drag
+    density on particles moving at 1 relative to the fluid, over phi."""
+    p = cfg.get("particles", {})
+    spheres = cfg.get("scene", {}).get("dimension", 2) == 3
+    radii = (0.5, 0.5 * p.get("size_ratio", 1.4))
+
+    def measure(a):
+        return 4.0 / 3.0 * math.pi * a ** 3 if spheres else math.pi * a * a
+
+    if p.get("mix", "volume") == "number":
+        weights = [measure(a) for a in radii]
+    else:
+        weights = [1.0, 1.0]
+    total = sum(weights)
+    lz = 1.0 if spheres else cfg.get("flow", {}).get("lz", 1.0)
+    return sum(w / total / measure(a) * 3.0 * math.pi * 2.0 * a for w, a in zip(weights, radii)) / lz
+
+
+def point_stresses(run):
+    """(J, mu, bulk pair sigma_xy / P, mu + drag to the bulk, dimension) of one finished point,
+    or None without profiles."""
+    s, cfg = run.summary, run.config
+    need = ("profile_y", "profile_phi", "profile_u_x", "profile_shear_stress", "profile_bin")
+    if any(s.get(k) is None for k in need) or s.get("mu") is None:
+        return None
+    J, H, b = s["J"], s["H"], s["profile_bin"]
+    e = cfg.get("observables", {}).get("wall_exclusion", 3.0)
+    c = drag_coefficient(cfg)
+    y, phi, ux, sxy = (s[k] for k in need[:4])
+    inside = [k for k in range(len(y)) if 0.0 <= y[k] <= H]
+    # Drag density on the particles of each bin (u_x and y in d, velocities over gammadot).
+    f = {k: c * J * phi[k] * (y[k] - ux[k]) for k in inside}
+    below, from_bottom = 0.0, {}
+    for k in inside:
+        from_bottom[k] = s["mu_bottom"] - (below + 0.5 * b * f[k])
+        below += b * f[k]
+    above, from_top = 0.0, {}
+    for k in reversed(inside):
+        from_top[k] = s["mu_top"] + above + 0.5 * b * f[k]
+        above += b * f[k]
+    band = [k for k in inside if e <= y[k] <= H - e]
+    if not band:
+        return None
+    mean = lambda v: sum(v) / len(v)  # noqa: E731
+    walls_plus_drag = 0.5 * (mean([from_bottom[k] for k in band]) + mean([from_top[k] for k in band]))
+    return J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag, s.get("dimension", 2)
+
+
+def boyer_less_fluid(J):
+    return BOYER_LAWS["mu"](J) - J
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("stores", nargs="+", type=pathlib.Path)
+    ap.add_argument("--points", action="store_true", help="print each point's row as well")
+    args = ap.parse_args()
+    by_j = {}
+    for path in args.stores:
+        if not (path / rundir.POINTS).is_dir():
+            sys.exit(f"{path}: no points/ folder (a sweep folder or results/<name>)")
+        for run in rundir.Store(path).points():
+            if not run.summary.get("stationary"):
+                continue
+            x = point_stresses(run)
+            if x is None:
+                continue
+            by_j.setdefault(x[0], []).append((run.path, x))
+    if not by_j:
+        sys.exit("no stationary finished point with profiles in " + ", ".join(map(str, args.stores)))
+    dims = {x[4] for rows in by_j.values() for _, x in rows}
+    if len(dims) > 1:
+        sys.exit("the stores mix discs and spheres: tabulate each on its own")
+    spheres = dims == {3}
+    if args.points:
+        print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk |")
+        print("|---|---|---|---|---|")
+        for J in sorted(by_j):
+            for path, (_, mu, bulk, plus, _) in by_j[J]:
+                print(f"| {path.parent.parent.name}/{path.name} | {J:g} | {mu:.3f} | {bulk:.3f} | "
+                      f"{plus:.3f} |")
+        print()
+    boyer = " Boyer | Boyer less J | bulk / Boyer | bulk / (Boyer less J) |" if spheres else ""
+    print("| J | points | mu (walls) | bulk sigma_xy / P (pair forces) | mu + drag to the bulk |" + boyer)
+    print("|---|---|---|---|---|" + "---|" * (4 if spheres else 0))
+    for J in sorted(by_j):
+        cols = list(zip(*[x[1:4] for _, x in by_j[J]]))
+        (mu, mu_e), (bulk, bulk_e), (plus, plus_e) = (rundir.mean_sem(c) for c in cols)
+        row = f"| {J:g} | {len(by_j[J])} | {pm(mu, mu_e)} | {pm(bulk, bulk_e)} | {pm(plus, plus_e)} |"
+        if spheres:
+            ref, less = BOYER_LAWS["mu"](J), boyer_less_fluid(J)
+            row += f" {ref:.3g} | {less:.3g} | {bulk / ref:.3f} | {bulk / less:.3f} |"
+        print(row)
+
+
+if __name__ == "__main__":
+    main()
