@@ -4,7 +4,7 @@
 // aspect 1.5, ktilde = 1e4, contact.sliding_stiffness = "sideways", started at random at its
 // volume fraction 0.52), after the packing has settled under the floating wall, with the
 // settling's steps and strain, and the bulk volume fraction, as counters; and the process's
-// peak resident memory.
+// peak resident memory. Also the observers' stress loops (stress_sample, stress_profiles).
 //
 // The settling is not what is timed, so it runs with a step ten times coarser (max_displacement
 // and max_overlap_change 1e-2 d): until the gap changed by less than 0.5 % over the last strain,
@@ -24,7 +24,9 @@
 
 #include "sheardiff/engine.hpp"
 #include "sheardiff/integrator/integrators.hpp"
+#include "sheardiff/integrator/stress.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
+#include "sheardiff/observe/profiles.hpp"
 
 namespace {
 
@@ -187,6 +189,30 @@ void full_step(benchmark::State& state) {
   label(state, p);
 }
 
+// The observers' pair-stress loops over the running cell's last solve: the cell's stress, which
+// the pressure cell samples every step, and the gap profiles' binned stresses with their
+// lubrication part (each pair's lubrication block formed again), every step of the measured
+// window. Their difference is what the lubrication part costs.
+void stress_sample(benchmark::State& state) {
+  Prepared& p = prepared(static_cast<int>(state.range(0)));
+  const auto& v = p.sim->integrator().velocities();
+  for (auto _ : state) benchmark::DoNotOptimize(measure_stress(*p.dynamics, v, p.cfg.flow.lz));
+  label(state, p);
+}
+
+void stress_profiles(benchmark::State& state) {
+  Prepared& p = prepared(static_cast<int>(state.range(0)));
+  const Dynamics3& d = *p.dynamics;
+  const auto& v = p.sim->integrator().velocities();
+  GapProfiles g(p.cfg.observables.profile_bin);
+  g.add(d.particles(), v.u, 0.0, d.height(), band_section(d), 1.0);
+  for (auto _ : state) {
+    g.add_stress(d, v, 0.0, p.cfg.flow.lz, 1.0);
+    benchmark::ClobberMemory();
+  }
+  label(state, p);
+}
+
 void sizes(benchmark::internal::Benchmark* b) {
   for (int n : {500, 1000, 2000}) b->Args({n});
   b->Unit(benchmark::kMillisecond);
@@ -198,6 +224,8 @@ BENCHMARK(assembly)->Apply(sizes);
 BENCHMARK(factorisation)->Apply(sizes);
 BENCHMARK(back_substitution)->Apply(sizes);
 BENCHMARK(full_step)->Apply(sizes);
+BENCHMARK(stress_sample)->Apply(sizes);
+BENCHMARK(stress_profiles)->Apply(sizes);
 
 }  // namespace
 

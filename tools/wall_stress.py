@@ -13,9 +13,13 @@ For each point this prints, averaged over the bulk band (the profile bins at lea
 `observables.wall_exclusion` from both wall lines, as phi):
 
   * sigma_xy / P of the pair forces (profile_shear_stress, docs/model.md section 9);
+  * where the points measured it (profile_shear_stress_lubrication), the part of the first that the
+    lubrication forces make, the rest being the contacts';
   * mu plus the drag between the walls and the band: the equation above, with n(y) 3 pi eta d from
     each bin's volume fraction (the species mixed as `particles.mix` says, in every bin alike) and
-    u_x(y) the bin's mean over the particles centred in it; the mean of the two walls' values.
+    u_x(y) the bin's mean over the particles centred in it (a bin without centres takes its
+    nearest such bin's); the mean of the two walls' values. --points adds the drag over the
+    whole gap, which the walls' difference mu_bottom - mu_top must equal.
 
 The two are independent measurements of one stress: the first from the pair forces, the second
 from the wall forces and the velocity profile. Per J: the mean over the stationary points (+- the
@@ -31,42 +35,58 @@ import pathlib
 import sys
 
 import rundir
-from results_table import BOYER_LAWS, pm
+from results_table import BOYER_LAWS, fmt, pm
 
 
 def drag_coefficient(cfg):
     """n 3 pi eta d per unit volume fraction (eta = 1, in P / (gammadot d) per d): the drag
-    density on particles moving at 1 relative to the fluid, over phi."""
+    density on particles moving at 1 relative to the fluid, over phi. The species' numbers are
+    in the ratio `particles.mix` sets (src/setup/random_packing.cpp): small to large 1 by number,
+    size_ratio^2 by area, size_ratio^3 by volume."""
     p = cfg.get("particles", {})
     spheres = cfg.get("scene", {}).get("dimension", 2) == 3
-    radii = (0.5, 0.5 * p.get("size_ratio", 1.4))
+    ratio = p.get("size_ratio", 1.4)
+    radii = (0.5, 0.5 * ratio)
 
     def measure(a):
         return 4.0 / 3.0 * math.pi * a ** 3 if spheres else math.pi * a * a
 
-    if p.get("mix", "volume") == "number":
-        weights = [measure(a) for a in radii]
-    else:
-        weights = [1.0, 1.0]
-    total = sum(weights)
+    small_per_large = {"number": 1.0, "area": ratio ** 2, "volume": ratio ** 3}[p.get("mix", "volume")]
+    numbers = (small_per_large, 1.0)
+    # Each species' share of the volume fraction, and its drag per unit of it.
+    shares = [n * measure(a) for n, a in zip(numbers, radii)]
     lz = 1.0 if spheres else cfg.get("flow", {}).get("lz", 1.0)
-    return sum(w / total / measure(a) * 3.0 * math.pi * 2.0 * a for w, a in zip(weights, radii)) / lz
+    return sum(w / sum(shares) / measure(a) * 3.0 * math.pi * 2.0 * a
+               for w, a in zip(shares, radii)) / lz
 
 
 def point_stresses(run):
-    """(J, mu, bulk pair sigma_xy / P, mu + drag to the bulk, dimension) of one finished point,
-    or None without profiles."""
+    """(J, mu, bulk pair sigma_xy / P, mu + drag to the bulk, dimension, net drag over the gap,
+    mu_bottom - mu_top, the lubrication part of the bulk's sigma_xy / P or None) of one finished
+    point, or None without profiles."""
     s, cfg = run.summary, run.config
-    need = ("profile_y", "profile_phi", "profile_u_x", "profile_shear_stress", "profile_bin")
+    need = ("profile_y", "profile_phi", "profile_u_x", "profile_shear_stress", "profile_bin",
+            "profile_T")
     if any(s.get(k) is None for k in need) or s.get("mu") is None:
         return None
     J, H, b = s["J"], s["H"], s["profile_bin"]
     e = cfg.get("observables", {}).get("wall_exclusion", 3.0)
     c = drag_coefficient(cfg)
-    y, phi, ux, sxy = (s[k] for k in need[:4])
+    y, phi, ux, sxy, _, temp = (s[k] for k in need)
     inside = [k for k in range(len(y)) if 0.0 <= y[k] <= H]
+    # A bin no particle is centred in reads u_x = T = 0 exactly, though the caps of its
+    # neighbours' particles give it a volume fraction (the bins at the walls): those particles
+    # move with the nearest bin that has centres.
+    centred = [k for k in inside if ux[k] != 0.0 or temp[k] != 0.0]
+    if not centred:
+        return None
+
+    def slip(k):
+        nearest = k if k in centred else min(centred, key=lambda m: abs(m - k))
+        return y[nearest] - ux[nearest]
+
     # Drag density on the particles of each bin (u_x and y in d, velocities over gammadot).
-    f = {k: c * J * phi[k] * (y[k] - ux[k]) for k in inside}
+    f = {k: c * J * phi[k] * slip(k) for k in inside}
     below, from_bottom = 0.0, {}
     for k in inside:
         from_bottom[k] = s["mu_bottom"] - (below + 0.5 * b * f[k])
@@ -80,7 +100,9 @@ def point_stresses(run):
         return None
     mean = lambda v: sum(v) / len(v)  # noqa: E731
     walls_plus_drag = 0.5 * (mean([from_bottom[k] for k in band]) + mean([from_top[k] for k in band]))
-    return J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag, s.get("dimension", 2)
+    lub = s.get("profile_shear_stress_lubrication")
+    return (J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag, s.get("dimension", 2),
+            below, s["mu_bottom"] - s["mu_top"], mean([lub[k] for k in band]) if lub else None)
 
 
 def boyer_less_fluid(J):
@@ -110,20 +132,28 @@ def main():
         sys.exit("the stores mix discs and spheres: tabulate each on its own")
     spheres = dims == {3}
     if args.points:
-        print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk |")
-        print("|---|---|---|---|---|")
+        # The drag over the whole gap is the walls' difference (x momentum of the whole cell):
+        # the check that the profiles hold the drag.
+        print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk | drag over the "
+              "gap / P | mu_bottom - mu_top | lubrication part of the bulk's / P |")
+        print("|---|---|---|---|---|---|---|---|")
         for J in sorted(by_j):
-            for path, (_, mu, bulk, plus, _) in by_j[J]:
+            for path, (_, mu, bulk, plus, _, gap, diff, lub) in by_j[J]:
                 print(f"| {path.parent.parent.name}/{path.name} | {J:g} | {mu:.3f} | {bulk:.3f} | "
-                      f"{plus:.3f} |")
+                      f"{plus:.3f} | {gap:+.3f} | {diff:+.3f} | {fmt(lub)} |")
         print()
     boyer = " Boyer | Boyer less J | bulk / Boyer | bulk / (Boyer less J) |" if spheres else ""
-    print("| J | points | mu (walls) | bulk sigma_xy / P (pair forces) | mu + drag to the bulk |" + boyer)
-    print("|---|---|---|---|---|" + "---|" * (4 if spheres else 0))
+    print("| J | points | mu (walls) | bulk sigma_xy / P (pair forces) | mu + drag to the bulk | "
+          "lubrication part of the bulk's (points) |" + boyer)
+    print("|---|---|---|---|---|---|" + "---|" * (4 if spheres else 0))
     for J in sorted(by_j):
         cols = list(zip(*[x[1:4] for _, x in by_j[J]]))
         (mu, mu_e), (bulk, bulk_e), (plus, plus_e) = (rundir.mean_sem(c) for c in cols)
-        row = f"| {J:g} | {len(by_j[J])} | {pm(mu, mu_e)} | {pm(bulk, bulk_e)} | {pm(plus, plus_e)} |"
+        # Points run before the lubrication part was measured have none: the mean of those that do.
+        lubs = [x[7] for _, x in by_j[J] if x[7] is not None]
+        lub = pm(*rundir.mean_sem(lubs)) + f" ({len(lubs)})" if lubs else "-"
+        row = (f"| {J:g} | {len(by_j[J])} | {pm(mu, mu_e)} | {pm(bulk, bulk_e)} | {pm(plus, plus_e)} "
+               f"| {lub} |")
         if spheres:
             ref, less = BOYER_LAWS["mu"](J), boyer_less_fluid(J)
             row += f" {ref:.3g} | {less:.3g} | {bulk / ref:.3f} | {bulk / less:.3f} |"

@@ -208,6 +208,14 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "array: -(sigma_xx + sigma_yy) / 2 of the pair forces (spheres: the trace over 3), "
             "binned "
             "the same way"},
+           {sk::profile_shear_stress_lubrication, "P",
+            "array: the part of profile_shear_stress the lubrication forces make (squeeze, shear "
+            "and pump, at contact the dashpots); the rest is the contacts' springs and, where it "
+            "is on, the repulsion. Written with lubrication on, unless the run was resumed "
+            "mid-window from a checkpoint of an earlier sheardiff (layout 8 or before)"},
+           {sk::profile_pressure_lubrication, "P",
+            "array: the part of profile_pressure the lubrication forces make, written as "
+            "profile_shear_stress_lubrication is"},
            {sk::bulk_shear_rate_ratio, "1",
             "slope of a least-squares line through u_x(y) over the bins at least "
             "`observables.wall_exclusion` from both walls, over the imposed gammadot (1 for a "

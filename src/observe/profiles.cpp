@@ -54,13 +54,48 @@ void GapProfiles::add(const ParticlesOf<D>& p, const std::vector<typename D::Bod
   }
 }
 
+namespace {
+
+// The force on j of the lubrication alone: the Lubrication law's block for the pair's geometry,
+// exactly as the force balance assembled it (it depends on the geometry alone), times the pair
+// velocity; zero where the law does not act.
+template <class D>
+typename D::Point lubrication_force_on_j(const Lubrication& law, const PairTermOf<D>& t,
+                                         bool touching, const typename D::Body& ui,
+                                         const typename D::Body& uj) {
+  if (!law.acts(t.g, touching)) return D::Point::Zero();
+  typename D::PairMatrix m = D::PairMatrix::Zero();
+  typename D::PairVector f = D::PairVector::Zero();
+  bool sliding = false;
+  PairBlockOf<typename D::PairMatrix, typename D::PairVector> b{m, f, sliding};
+  law.add_block(t.g, NoHistory{}, touching, 0.0, b);
+  typename D::PairVector u;
+  u << ui, uj + t.image_j;
+  return -(m.template middleRows<D::space>(D::body) * u);
+}
+
+// A pair's shares of sigma_xy and of the trace pressure: force fj on j, lever arm l along n.
+template <class D>
+std::pair<double, double> pair_stress(const typename D::Point& n, const typename D::Point& fj,
+                                      double l) {
+  const double sxx = -l * n.x() * fj.x(), syy = -l * n.y() * fj.y();
+  // The pressure of the trace: two normal stresses of discs, three of spheres.
+  double pressure = -0.5 * (sxx + syy);
+  if constexpr (D::space == 3) pressure = -(sxx + syy - l * n.z() * fj.z()) / 3.0;
+  return {-0.5 * l * (n.x() * fj.y() + n.y() * fj.x()), pressure};
+}
+
+}  // namespace
+
 template <class D>
 void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double yb, double lz,
                              double weight) {
   const auto bins = static_cast<long>(w_.size());
   if (bins == 0) return;
-  sxy_.resize(w_.size(), 0.0);
-  sp_.resize(w_.size(), 0.0);
+  const auto& lubrication = d.force_balance().lubrication();
+  for (auto* vec : {&sxy_, &sp_}) vec->resize(w_.size(), 0.0);
+  if (lubrication)
+    for (auto* vec : {&sxy_lub_, &sp_lub_}) vec->resize(w_.size(), 0.0);
   const double volume = horizontal_area(d, lz) * bin_;
   const auto& pairs = d.neighbours().pairs();
   const auto& terms = d.force_balance().terms();
@@ -75,12 +110,15 @@ void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, d
     // The same pair stress as measure_stress (observe/stress.cpp), binned.
     const auto fj = t.force(v.u[pr.i], v.u[pr.j]).template segment<D::space>(D::body).eval();
     const double l = pr.history.touching ? t.g.r : t.g.s;
-    const double sxx = -l * t.g.n.x() * fj.x(), syy = -l * t.g.n.y() * fj.y();
-    sxy_[c] += weight * -0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x()) / volume;
-    // The pressure of the trace: two normal stresses of discs, three of spheres.
-    double pressure = -0.5 * (sxx + syy);
-    if constexpr (D::space == 3) pressure = -(sxx + syy - l * t.g.n.z() * fj.z()) / 3.0;
+    const auto [sxy, pressure] = pair_stress<D>(t.g.n, fj, l);
+    sxy_[c] += weight * sxy / volume;
     sp_[c] += weight * pressure / volume;
+    if (!lubrication) continue;
+    const auto fl =
+        lubrication_force_on_j<D>(*lubrication, t, pr.history.touching, v.u[pr.i], v.u[pr.j]);
+    const auto [sxy_l, pressure_l] = pair_stress<D>(t.g.n, fl, l);
+    sxy_lub_[c] += weight * sxy_l / volume;
+    sp_lub_[c] += weight * pressure_l / volume;
   }
 }
 
@@ -133,6 +171,15 @@ void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
     }
     js[summary_key::profile_shear_stress] = sxy;  // sigma_xy of the pair forces, P
     js[summary_key::profile_pressure] = sp;  // -(sigma_xx + sigma_yy) / 2 of the pair forces, P
+  }
+  if (sxy_lub_.size() == w_.size() && !lubrication_partial_) {
+    std::vector<double> sxy(w_.size()), sp(w_.size());
+    for (std::size_t b = 0; b < w_.size(); ++b) {
+      sxy[b] = w_[b] > 0 ? sxy_lub_[b] / w_[b] : 0.0;
+      sp[b] = w_[b] > 0 ? sp_lub_[b] / w_[b] : 0.0;
+    }
+    js[summary_key::profile_shear_stress_lubrication] = sxy;
+    js[summary_key::profile_pressure_lubrication] = sp;
   }
 }
 

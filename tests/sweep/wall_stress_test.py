@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """tools/wall_stress.py on synthetic points with a known answer. The particles lag the imposed
-flow by eps (y - H/2) at a uniform volume fraction phi, so the drag density is
-f = c J phi eps (y - H/2), c the mixture's 3 pi d per unit volume fraction, and x momentum
-balance gives sigma_xy(y) = mu - c J phi eps (y^2 / 2 - H y / 2) from either wall; the tool's
-"mu + drag to the bulk" must be that stress's mean over the bulk band's bin centres. The pair
-stress column must read the profile's band mean; a point whose window failed the stationarity
-test is left out; discs and spheres together are refused. Usage: wall_stress_test.py REPO WORK"""
+flow by eps (y - y0) at a uniform volume fraction phi, y0 below mid-gap, so the drag density is
+f = c J phi eps (y - y0), c the mixture's 3 pi d per unit volume fraction, and the walls differ by
+the drag over the whole gap. The bin under the top wall holds caps of particles but no centre
+(u_x = T = 0 there, as a run writes it): its particles move as the nearest bin's. x momentum
+balance then gives the stress at every y below it in closed form, from either wall; the tool's
+"mu + drag to the bulk" must be its mean over the bulk band's bin centres. The pair stress column
+and its lubrication part must read the profiles' band means; a point whose window failed the stationarity test is left out;
+discs and spheres together are refused. Usage: wall_stress_test.py REPO WORK"""
 import json
 import math
 import pathlib
@@ -13,32 +15,53 @@ import subprocess
 import sys
 
 repo, work = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
-J, phi, eps, H, b, mu, e = 0.05, 0.5, 0.02, 16.0, 0.5, 0.7, 3.0
+J, phi, eps, H, b, mu_top, e, y0 = 0.05, 0.5, 0.02, 16.0, 0.5, 0.7, 3.0, 6.0
+phi_edge = 0.3  # the volume fraction of the bin under the top wall, which has no centre
 ys = [(k + 0.5) * b for k in range(int(H / b) + 4)]  # bins run past the top wall, as a run's do
+edge = int(H / b) - 1  # the last bin below the top wall's line
 
 
-def write_point(store, name, dimension, mix, stationary=True, sxy_band=0.9):
+def drag(c):
+    """Per bin below H: the drag density the synthetic profile holds."""
+    return [c * J * (phi_edge * eps * (ys[k - 1] - y0) if k == edge else phi * eps * (ys[k] - y0))
+            for k in range(edge + 1)]
+
+
+def write_point(store, name, dimension, mix, c, lz=1.0, stationary=True, sxy_band=0.9,
+                lubrication_band=None):
     d = store / "points" / name
     d.mkdir(parents=True, exist_ok=True)
     (d / "config.toml").write_text(
         f'[scene]\ntype = "pressure_shear"\ndimension = {dimension}\n'
-        f'[particles]\nmix = "{mix}"\nsize_ratio = 1.4\n[flow]\nlz = 1.0\n'
+        f'[particles]\nmix = "{mix}"\nsize_ratio = 1.4\n[flow]\nlz = {lz}\n'
         f'[observables]\nwall_exclusion = {e}\n')
-    inside = [y <= H for y in ys]
+    mu_bottom = mu_top + sum(drag(c)) * b  # x momentum of the whole cell
+    centred = [k < edge for k in range(len(ys))]
     summary = {
-        "J": J, "H": H, "mu": mu, "mu_top": mu, "mu_bottom": mu, "dimension": dimension,
-        "stationary": stationary, "profile_bin": b, "profile_y": ys,
-        "profile_phi": [phi if i else 0.0 for i in inside],
-        "profile_u_x": [y * (1 - eps) + eps * H / 2 if i else 0.0 for y, i in zip(ys, inside)],
+        "J": J, "H": H, "mu": 0.5 * (mu_top + mu_bottom), "mu_top": mu_top, "mu_bottom": mu_bottom,
+        "dimension": dimension, "stationary": stationary, "profile_bin": b, "profile_y": ys,
+        "profile_phi": [phi if k < edge else (phi_edge if k == edge else 0.0)
+                        for k in range(len(ys))],
+        "profile_u_x": [y - eps * (y - y0) if i else 0.0 for y, i in zip(ys, centred)],
+        "profile_T": [0.01 if i else 0.0 for i in centred],
         # the band's bins read sxy_band, the walls' another value the band mean must not see
         "profile_shear_stress": [sxy_band if e <= y <= H - e else 0.3 for y in ys],
     }
+    if lubrication_band is not None:
+        summary["profile_shear_stress_lubrication"] = [lubrication_band if e <= y <= H - e else 0.1
+                                                       for y in ys]
     (d / "summary.json").write_text(json.dumps(summary))
 
 
 def expected(c):
+    """The stress at each band centre y from the top wall: mu_top + the drag above y, in closed
+    form (the linear drag below the edge bin, integrated exactly) plus the edge bin's."""
+    f = drag(c)
     band = [y for y in ys if e <= y <= H - e]
-    return sum(mu - c * J * phi * eps * (y * y / 2 - H * y / 2) for y in band) / len(band)
+    below_edge = H - b
+    def integral(y):  # of c J phi eps (y' - y0) from y to the edge bin's lower side
+        return c * J * phi * eps * ((below_edge ** 2 - y ** 2) / 2 - y0 * (below_edge - y))
+    return sum(mu_top + integral(y) + f[edge] * b for y in band) / len(band)
 
 
 def row_cells(out, first):
@@ -53,28 +76,41 @@ def run(*stores):
 
 
 # Spheres, equal volumes of d and 1.4 d: number per volume (phi / 2) / (pi a^3 4 / 3) each.
-spheres = work / "spheres"
-write_point(spheres, "seed=1", 3, "volume")
-write_point(spheres, "seed=2", 3, "volume", stationary=False, sxy_band=5.0)
 c3 = sum(0.5 / (4 / 3 * math.pi * a ** 3) * 3 * math.pi * 2 * a for a in (0.5, 0.7))
+spheres = work / "spheres"
+write_point(spheres, "seed=1", 3, "volume", c3, lubrication_band=0.4)
+write_point(spheres, "seed=2", 3, "volume", c3, stationary=False, sxy_band=5.0)
 r = run(spheres)
 assert r.returncode == 0, r.stderr
 cells = row_cells(r.stdout, "0.05")
 assert cells[1] == "1", f"the drifting point must not count: {cells}"
 assert abs(float(cells[3]) - 0.9) < 1e-9, cells
 assert abs(float(cells[4]) - expected(c3)) < 1.5e-3, (cells, expected(c3))
-assert expected(c3) - mu > 0.1, "the drag term must be large enough to test"
+assert abs(expected(c3) - mu_top) > 0.1, "the drag term must be large enough to test"
 boyer = 0.32 + 0.38 / (1 + 0.005 / J) + J + 2.5 * 0.585 * J ** 0.5
-assert abs(float(cells[8]) - 0.9 / (boyer - J)) < 1e-3, cells
+assert cells[5] == "0.4 (1)", f"the band's lubrication part, from the one point: {cells}"
+assert abs(float(cells[9]) - 0.9 / (boyer - J)) < 1e-3, cells
 
-# Discs mixed by number in a monolayer of thickness l_z = 1: area fractions a^2 / (sum a^2).
+# The check of --points: the drag over the whole gap is the walls' difference (the synthetic
+# walls were set so), the mean of the two walls' estimates being blind to which wall is which.
+r = subprocess.run([sys.executable, str(repo / "tools/wall_stress.py"), "--points", str(spheres)],
+                   capture_output=True, text=True)
+assert r.returncode == 0, r.stderr
+cells = row_cells(r.stdout, "spheres/seed=1")
+assert abs(float(cells[5]) - float(cells[6])) < 1.5e-3 and abs(float(cells[6])) > 0.1, cells
+assert abs(float(cells[7]) - 0.4) < 1e-9, cells
+
+# Discs mixed by volume (1.4^3 small discs to a large one) in a monolayer of thickness 1.5:
+# the species' area fractions are their numbers times their areas.
+shares = [1.4 ** 3 * 0.25, 0.49]
+c2 = sum(w / sum(shares) / (math.pi * a * a) * 3 * math.pi * 2 * a
+         for w, a in zip(shares, (0.5, 0.7))) / 1.5
 discs = work / "discs"
-write_point(discs, "seed=1", 2, "number")
-c2 = sum(a * a / (0.25 + 0.49) / (math.pi * a * a) * 3 * math.pi * 2 * a for a in (0.5, 0.7))
+write_point(discs, "seed=1", 2, "volume", c2, lz=1.5)
 r = run(discs)
 assert r.returncode == 0, r.stderr
 cells = row_cells(r.stdout, "0.05")
-assert len(cells) == 5, f"discs have no Boyer columns: {cells}"
+assert len(cells) == 6 and cells[5] == "-", f"discs have no Boyer columns, these none measured: {cells}"
 assert abs(float(cells[4]) - expected(c2)) < 1.5e-3, (cells, expected(c2))
 
 r = run(spheres, discs)

@@ -582,7 +582,7 @@ TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
-  const std::string now = "sheardiff-checkpoint-8", before = "sheardiff-checkpoint-3";
+  const std::string now = "sheardiff-checkpoint-9", before = "sheardiff-checkpoint-3";
   ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
   std::memcpy(bytes.data() + 8, before.data(), before.size());  // the CRC covers the payload only
   write_bytes(root / "old" / "checkpoint.bin", bytes);
@@ -603,7 +603,7 @@ TEST(Checkpoint, FrameKeepingDiffusionLayoutIsRefusedWithItsReason) {
   const fs::path cfg = write_config(root, "simple_shear");
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
-  const std::string now = "sheardiff-checkpoint-8", before = "sheardiff-checkpoint-5";
+  const std::string now = "sheardiff-checkpoint-9", before = "sheardiff-checkpoint-5";
   ASSERT_EQ(std::string(bytes.data() + 8, now.size()), now);
   std::memcpy(bytes.data() + 8, before.data(), before.size());
   write_bytes(root / "old" / "checkpoint.bin", bytes);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <numeric>
 
+#include "sheardiff/core/archive.hpp"
 #include "sheardiff/observe/profiles.hpp"
 #include "sheardiff/run.hpp"
 #include "sheardiff/run_parts.hpp"
@@ -66,6 +67,125 @@ TEST(ProfilesObserver, BinsAddUpToTheCell) {
   for (std::size_t i = 0; i < p.n_mobile; ++i) area += kPi * p.radius[i] * p.radius[i];
   EXPECT_NEAR(sum("profile_phi") * d.box().lx, area, 1e-9 * area);
   EXPECT_EQ(js["profile_y"].size(), js["profile_pressure"].size());
+}
+
+// The lubrication part of the profiles' stresses, after `steps` steps of cfg: its bins add up to
+// the stress of every pair's lubrication force, recomputed here from the law's coefficients and
+// the solved velocities, and it is not the whole stress (the contacts carry some). Returns the
+// summary.
+template <class D>
+nlohmann::json expect_lubrication_part(const Config& cfg, int steps) {
+  SimulationOf<D> sim(cfg);
+  for (int k = 0; k < steps; ++k) sim.step();
+  const auto& d = sim.dynamics();
+  const auto& v = sim.integrator().velocities();
+  ProfilesObserverOf<D> profiles(cfg, [](const DynamicsOf<D>&) { return true; });
+  const StressSample s = sim.sample();
+  profiles.on_step(StepViewOf<D>{d, v, s, 1.0});
+  nlohmann::json js;
+  profiles.finish(d, js, nullptr);
+  const Lubrication& law = *d.force_balance().lubrication();
+  const auto& pairs = d.neighbours().pairs();
+  const auto& terms = d.force_balance().terms();
+  double sxy = 0.0;
+  int lubricated = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto& t = terms[k];
+    const auto& pr = pairs[k];
+    if (!t.on || !(pr.history.touching || t.g.h < cfg.lubrication.h_max)) continue;
+    ++lubricated;
+    const PairResistance r = law.coefficients(t.g.ai, t.g.aj, t.g.h);
+    typename D::PairMatrix m;
+    if constexpr (D::space == 2)
+      m = r.matrix(t.g.n, t.g.t);
+    else
+      m = r.matrix_3d(t.g.n);
+    typename D::PairVector u;
+    u << v.u[pr.i], v.u[pr.j] + t.image_j;
+    const typename D::Point fj = -(m * u).template segment<D::space>(D::body);
+    const double l = pr.history.touching ? t.g.r : t.g.s;
+    sxy -= 0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x());
+  }
+  sxy /= horizontal_area(d, cfg.flow.lz);
+  const double bin = cfg.observables.profile_bin;
+  const auto sum = [&](const char* key) {
+    const auto vals = js[key].get<std::vector<double>>();
+    return std::accumulate(vals.begin(), vals.end(), 0.0) * bin;
+  };
+  EXPECT_GT(lubricated, 10);
+  EXPECT_GT(s.contacts, 0);
+  EXPECT_NEAR(sum("profile_shear_stress_lubrication"), sxy, 1e-10 * std::abs(s.pressure()));
+  // The contacts' part, the rest, is a sizeable share: the test tells the two apart.
+  const double total = sum("profile_shear_stress");
+  EXPECT_GT(std::abs(total - sxy), 0.05 * std::abs(total));
+  EXPECT_EQ(js["profile_pressure_lubrication"].size(), js["profile_pressure"].size());
+  return js;
+}
+
+TEST(ProfilesObserver, LubricationPartOfTheStressOfDiscs) {
+  expect_lubrication_part<Dim2>(cell_config("pressure_shear"), 300);
+}
+
+TEST(ProfilesObserver, LubricationPartOfTheStressOfSpheres) {
+  Config cfg = cell_config("pressure_shear");
+  cfg.scene.dimension = 3;
+  cfg.particles.n = 64;
+  cfg.particles.phi_init_spheres = 0.5;  // dense enough for contacts from the start
+  cfg.contact.ktilde = 1e3;
+  expect_lubrication_part<Dim3>(cfg, 100);
+}
+
+// Without lubrication there is no lubrication part to report.
+TEST(ProfilesObserver, NoLubricationPartWithoutLubrication) {
+  Config cfg = cell_config("pressure_shear");
+  cfg.lubrication.enabled = false;
+  Simulation sim(cfg);
+  for (int k = 0; k < 50; ++k) sim.step();
+  ProfilesObserver profiles(cfg, [](const Dynamics&) { return true; });
+  profiles.on_step(StepView{sim.dynamics(), sim.integrator().velocities(), sim.sample(), 1.0});
+  nlohmann::json js;
+  profiles.finish(sim.dynamics(), js, nullptr);
+  EXPECT_TRUE(js.contains("profile_shear_stress"));
+  EXPECT_FALSE(js.contains("profile_shear_stress_lubrication"));
+}
+
+// A checkpoint of layout 8 kept no lubrication part: resumed before the window began, the part
+// covers the window; resumed inside it, it would cover only the rest, so none is reported. A
+// layout-9 checkpoint keeps it.
+TEST(ProfilesObserver, LubricationPartOnlyOverTheWholeWindow) {
+  Simulation sim(cell_config("pressure_shear"));
+  sim.step();
+  const Dynamics& d = sim.dynamics();
+  const Velocities& v = sim.integrator().velocities();
+  const auto one_step = [&](GapProfiles& g) {
+    g.add(d.particles(), v.u, 0.0, d.height(), d.box().lx, 1.0);
+    g.add_stress(d, v, 0.0, 1.0, 1.0);
+  };
+  const auto reported_after_resume = [&](Archive reader) {
+    GapProfiles g(0.5);
+    g.serialize(reader);
+    one_step(g);
+    nlohmann::json js;
+    g.to_summary(js, 1.0, d.height(), 3.0);
+    EXPECT_TRUE(js.contains("profile_shear_stress"));
+    return js.contains("profile_shear_stress_lubrication");
+  };
+  // What layout 8 wrote: the section and the eight accumulators, empty before the window.
+  const auto layout8 = [](std::size_t bins) {
+    Archive a = Archive::writer();
+    double section = 1.0;
+    a.io(section);
+    std::vector<double> acc(bins, 1.0);
+    for (int k = 0; k < 8; ++k) a.io(acc);
+    return Archive::reader(a.bytes(), 8);
+  };
+  EXPECT_TRUE(reported_after_resume(layout8(0)));
+  EXPECT_FALSE(reported_after_resume(layout8(4)));
+  GapProfiles begun(0.5);
+  one_step(begun);
+  Archive now = Archive::writer();
+  begun.serialize(now);
+  EXPECT_TRUE(reported_after_resume(Archive::reader(now.bytes())));
 }
 
 }  // namespace

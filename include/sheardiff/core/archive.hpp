@@ -17,7 +17,7 @@ class Archive {
  public:
   // The state layout this sheardiff writes (the digit of a checkpoint's magic): a section whose
   // shape changed reads an older layout's by asking layout().
-  static constexpr int kLayout = 8;
+  static constexpr int kLayout = 9;
   static Archive writer() { return Archive(false, {}, kLayout); }
   static Archive reader(std::vector<char> bytes, int layout = kLayout) {
     return Archive(true, std::move(bytes), layout);

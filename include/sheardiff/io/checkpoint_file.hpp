@@ -1,7 +1,7 @@
 #pragma once
 // The file format of DIR/checkpoint.bin: a header, then the run's archived state (Archive).
 //
-//   u64 22, "sheardiff-checkpoint-8"   (the magic, as Archive writes a string; the digit is
+//   u64 22, "sheardiff-checkpoint-9"   (the magic, as Archive writes a string; the digit is
 //                                        the layout of the state that follows)
 //   u64 payload length in bytes
 //   u32 CRC-32 (zlib) of the payload
@@ -19,7 +19,9 @@
 // reading: a layout-6 pressure-cell checkpoint resumes. Layout 8 keeps, for each contact of
 // spheres, the stiffness its last cap left across its stretch (TangentialSpring3::across); a
 // layout-7 checkpoint resumes with 1 there, which only contact.sliding_stiffness = "sideways"
-// reads, for the step after the resume.
+// reads, for the step after the resume. Layout 9 adds the lubrication part of the gap profiles'
+// stresses: a layout-8 checkpoint resumes, and a window it had begun reports no lubrication part.
+// 9 is the last layout one digit of the magic holds.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -43,7 +45,7 @@ std::vector<char> checkpoint_file_bytes(const std::vector<char>& payload);
 struct CheckpointPayload {
   std::vector<char> bytes;        // the archived state, after the magic
   bool checksummed = true;        // false: a version 2 file, read without a check
-  int layout = Archive::kLayout;  // the state layout: 2 to 8 (the magic's digit)
+  int layout = Archive::kLayout;  // the state layout: 2 to 9 (the magic's digit)
 };
 
 // Reads and checks FILE: the magic, the length against the file size, the CRC. Throws

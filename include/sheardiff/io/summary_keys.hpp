@@ -95,6 +95,8 @@ inline constexpr const char* profile_u_x = "profile_u_x";
 inline constexpr const char* profile_T = "profile_T";
 inline constexpr const char* profile_shear_stress = "profile_shear_stress";
 inline constexpr const char* profile_pressure = "profile_pressure";
+inline constexpr const char* profile_shear_stress_lubrication = "profile_shear_stress_lubrication";
+inline constexpr const char* profile_pressure_lubrication = "profile_pressure_lubrication";
 inline constexpr const char* bulk_shear_rate_ratio = "bulk_shear_rate_ratio";
 inline constexpr const char* profiles_from = "profiles_from";
 

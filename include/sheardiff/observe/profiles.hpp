@@ -2,6 +2,7 @@
 // Profiles across the gap of a scene with walls (docs/model.md section 9): phi(y), u_x(y), the
 // fluctuation temperature T(y) = <u'.u'> and the stresses sigma_xy(y) and p(y), in bins measured
 // from the bottom wall's centre line, averaged over the run's measured window.
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -32,7 +33,8 @@ class GapProfiles {
   void add(const ParticlesOf<D>& p, const std::vector<typename D::Body>& u, double y_bottom,
            double height, double section, double weight);
   // The pair stresses of the step (sigma = -sum l n f / V): each pair's share in the bin of its
-  // midpoint; lz: the monolayer's thickness (discs).
+  // midpoint; lz: the monolayer's thickness (discs). With lubrication, also the part of them
+  // its forces make (the rest is the contacts' springs, and the repulsion where it is on).
   template <class D>
   void add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y_bottom, double lz,
                   double weight);
@@ -40,19 +42,30 @@ class GapProfiles {
   // Rows = bins; columns y (bin centre), phi, u_x, T.
   Eigen::MatrixXd table() const;
   // The table into summary: profile_{y, phi, u_x, T} with velocities over gammadot (and, when
-  // measured, profile_shear_stress and profile_pressure in P), and the shear rate of the bulk
-  // (a line fit of u_x over the bins at least `exclusion` from both walls) over the imposed
-  // gammadot = V / H.
+  // measured, profile_shear_stress and profile_pressure in P, and their lubrication parts when
+  // measured over the whole window), and the shear rate of the bulk (a line fit of u_x over the
+  // bins at least `exclusion` from both walls) over the imposed gammadot = V / H.
   void to_summary(nlohmann::json& js, double gammadot, double height, double exclusion) const;
   void serialize(Archive& a) {
     a.io(section_);
     for (auto* v : {&w_, &area_, &n_, &ux_, &ux2_, &uy2_, &sxy_, &sp_}) a.io(*v);
+    if (!a.loading() || a.layout() >= 9) {
+      for (auto* v : {&sxy_lub_, &sp_lub_}) a.io(*v);
+      a.io(lubrication_partial_);
+    } else {
+      // Layout 8 and earlier kept no lubrication part: a window already under way when such a
+      // checkpoint was written has its lubrication part over only what follows, so none is
+      // reported.
+      lubrication_partial_ = std::any_of(w_.begin(), w_.end(), [](double w) { return w > 0.0; });
+    }
   }
 
  private:
   void grow(std::size_t bins);
   double bin_, section_ = 1.0;  // the cell's extent normal to y (lx, or lx lz for spheres)
   std::vector<double> w_, area_, n_, ux_, ux2_, uy2_, sxy_, sp_;
+  std::vector<double> sxy_lub_, sp_lub_;  // the lubrication forces' part of sxy_, sp_
+  bool lubrication_partial_ = false;      // resumed from a layout without it, mid-window
 };
 
 // The profiles as an observer of any scene with walls, over the measured window.
