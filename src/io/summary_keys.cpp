@@ -222,7 +222,7 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "linear profile); written with 3 or more such bins"},
            {sk::profiles_from, "-",
             "\"frames\": only in a summary completed by `sheardiff analyse` for a run without "
-            "profiles, computed from the trajectory's frames (without the two stress profiles)"},
+            "profiles, computed from the trajectory's frames (without the stress profiles)"},
        }},
       {"The diffusion analysis",
        "Self-diffusion in the gradient direction y over the measured window: after "
