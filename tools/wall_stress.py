@@ -28,6 +28,7 @@ suspending fluid's own stress eta gammadot, which no force of this model carries
 
     /usr/bin/python3 tools/wall_stress.py STORE [STORE ...]     # e.g. results/sweep_3d_j01 results/sweep_3d
     /usr/bin/python3 tools/wall_stress.py --points STORE ...    # one row per point as well
+    /usr/bin/python3 tools/wall_stress.py --include-not-stationary ...   # the failed windows too
 """
 import argparse
 import math
@@ -113,13 +114,16 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("stores", nargs="+", type=pathlib.Path)
     ap.add_argument("--points", action="store_true", help="print each point's row as well")
+    ap.add_argument("--include-not-stationary", action="store_true",
+                    help="count the points whose window failed the stationarity test too (as "
+                         "`sheardiff fit --include-not-stationary`); their rows say so")
     args = ap.parse_args()
     by_j = {}
     for path in args.stores:
         if not (path / rundir.POINTS).is_dir():
             sys.exit(f"{path}: no points/ folder (a sweep folder or results/<name>)")
         for run in rundir.Store(path).points():
-            if not run.summary.get("stationary"):
+            if not run.summary.get("stationary") and not args.include_not_stationary:
                 continue
             x = point_stresses(run)
             if x is None:
@@ -139,7 +143,8 @@ def main():
         print("|---|---|---|---|---|---|---|---|")
         for J in sorted(by_j):
             for path, (_, mu, bulk, plus, _, gap, diff, lub) in by_j[J]:
-                print(f"| {path.parent.parent.name}/{path.name} | {J:g} | {mu:.3f} | {bulk:.3f} | "
+                flag = "" if rundir.Run(path).summary.get("stationary") else " (not stationary)"
+                print(f"| {path.parent.parent.name}/{path.name}{flag} | {J:g} | {mu:.3f} | {bulk:.3f} | "
                       f"{plus:.3f} | {gap:+.3f} | {diff:+.3f} | {fmt(lub)} |")
         print()
     boyer = " Boyer | Boyer less J | bulk / Boyer | bulk / (Boyer less J) |" if spheres else ""

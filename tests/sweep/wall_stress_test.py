@@ -100,6 +100,13 @@ cells = row_cells(r.stdout, "spheres/seed=1")
 assert abs(float(cells[5]) - float(cells[6])) < 1.5e-3 and abs(float(cells[6])) > 0.1, cells
 assert abs(float(cells[7]) - 0.4) < 1e-9, cells
 
+# The drifting point counts when asked, and its row says it failed the test.
+r = subprocess.run([sys.executable, str(repo / "tools/wall_stress.py"), "--points",
+                    "--include-not-stationary", str(spheres)], capture_output=True, text=True)
+assert r.returncode == 0, r.stderr
+assert len(row_cells(r.stdout, "spheres/seed=2 (not stationary)")) == 8, r.stdout
+assert row_cells(r.stdout, "0.05")[1] == "2", r.stdout
+
 # Discs mixed by volume (1.4^3 small discs to a large one) in a monolayer of thickness 1.5:
 # the species' area fractions are their numbers times their areas.
 shares = [1.4 ** 3 * 0.25, 0.49]
