@@ -37,11 +37,11 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
     const auto& pr = pairs[k];
     const auto fj = t.force(v.u[pr.i], v.u[pr.j]).template segment<D::space>(D::body).eval();
     const bool contact = pr.history.touching;
-    const double l = contact ? t.g.r : t.g.s;
-    s.sxx -= l * t.g.n.x() * fj.x();
-    s.syy -= l * t.g.n.y() * fj.y();
-    s.sxy -= 0.5 * l * (t.g.n.x() * fj.y() + t.g.n.y() * fj.x());
-    if constexpr (D::space == 3) s.szz -= l * t.g.n.z() * fj.z();
+    const auto ps = pair_stress<D>(t.g.n, fj, pair_lever_arm(t.g, contact));
+    s.sxx += ps.xx;
+    s.syy += ps.yy;
+    s.sxy += ps.xy;
+    s.szz += ps.zz;
     if (contact) {
       ++s.contacts;
       const double ov = std::max(t.g.overlap(), 0.0);

@@ -74,17 +74,6 @@ typename D::Point lubrication_force_on_j(const Lubrication& law, const PairTermO
   return -(m.template middleRows<D::space>(D::body) * u);
 }
 
-// A pair's shares of sigma_xy and of the trace pressure: force fj on j, lever arm l along n.
-template <class D>
-std::pair<double, double> pair_stress(const typename D::Point& n, const typename D::Point& fj,
-                                      double l) {
-  const double sxx = -l * n.x() * fj.x(), syy = -l * n.y() * fj.y();
-  // The pressure of the trace: two normal stresses of discs, three of spheres.
-  double pressure = -0.5 * (sxx + syy);
-  if constexpr (D::space == 3) pressure = -(sxx + syy - l * n.z() * fj.z()) / 3.0;
-  return {-0.5 * l * (n.x() * fj.y() + n.y() * fj.x()), pressure};
-}
-
 }  // namespace
 
 template <class D>
@@ -107,18 +96,18 @@ void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, d
     const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y() - yb;
     // A pair with a wall disc may have its midpoint just outside the bins: the nearest one.
     const long c = std::clamp(static_cast<long>(std::floor(mid / bin_)), 0L, bins - 1);
-    // The same pair stress as measure_stress (observe/stress.cpp), binned.
+    // The same pair stress as measure_stress (integrator/stress.cpp), binned.
     const auto fj = t.force(v.u[pr.i], v.u[pr.j]).template segment<D::space>(D::body).eval();
-    const double l = pr.history.touching ? t.g.r : t.g.s;
-    const auto [sxy, pressure] = pair_stress<D>(t.g.n, fj, l);
-    sxy_[c] += weight * sxy / volume;
-    sp_[c] += weight * pressure / volume;
+    const double l = pair_lever_arm(t.g, pr.history.touching);
+    const auto ps = pair_stress<D>(t.g.n, fj, l);
+    sxy_[c] += weight * ps.xy / volume;
+    sp_[c] += weight * ps.pressure(D::space == 3) / volume;
     if (!lubrication) continue;
     const auto fl =
         lubrication_force_on_j<D>(*lubrication, t, pr.history.touching, v.u[pr.i], v.u[pr.j]);
-    const auto [sxy_l, pressure_l] = pair_stress<D>(t.g.n, fl, l);
-    sxy_lub_[c] += weight * sxy_l / volume;
-    sp_lub_[c] += weight * pressure_l / volume;
+    const auto pl = pair_stress<D>(t.g.n, fl, l);
+    sxy_lub_[c] += weight * pl.xy / volume;
+    sp_lub_[c] += weight * pl.pressure(D::space == 3) / volume;
   }
 }
 

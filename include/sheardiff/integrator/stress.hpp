@@ -23,6 +23,30 @@ struct StressSample {
   double bottom_wall_fy = 0.0;
 };
 
+// One pair's share of sigma times the volume: -sym(l n (x) F_j), F_j the pair force on j along
+// the lever arm l n (pair_lever_arm). Shared by the cell's stress and the gap profiles' binned one,
+// so that the two sum the same quantity.
+struct PairStress {
+  double xx = 0, yy = 0, zz = 0, xy = 0;  // zz: spheres only
+  // The pair's share of the trace pressure: two normal stresses of discs, three of spheres.
+  double pressure(bool spheres) const { return spheres ? -(xx + yy + zz) / 3.0 : -0.5 * (xx + yy); }
+};
+template <class D>
+PairStress pair_stress(const typename D::Point& n, const typename D::Point& fj, double l) {
+  PairStress s;
+  s.xx = -l * n.x() * fj.x();
+  s.yy = -l * n.y() * fj.y();
+  s.xy = -0.5 * l * (n.x() * fj.y() + n.y() * fj.x());
+  if constexpr (D::space == 3) s.zz = -l * n.z() * fj.z();
+  return s;
+}
+// The lever arm of a pair's stress: the centre distance r of a pair in contact, the surface gap
+// s of an open one (docs/model.md section 9).
+template <class Geometry>
+double pair_lever_arm(const Geometry& g, bool touching) {
+  return touching ? g.r : g.s;
+}
+
 // Discs or spheres; lz is a monolayer's thickness (spheres: the cell's own lz is used).
 template <class D>
 StressSample measure_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double lz);
