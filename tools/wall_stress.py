@@ -14,7 +14,8 @@ For each point this prints, averaged over the bulk band (the profile bins at lea
 
   * sigma_xy / P of the pair forces (profile_shear_stress, docs/model.md section 9);
   * where the points measured it (profile_shear_stress_lubrication), the part of the first that the
-    lubrication forces make, the rest being the contacts';
+    lubrication forces make, the rest being the contacts'; for spheres, a second table sets the
+    two parts beside the contact and hydrodynamic terms of Boyer et al.'s fit (for orientation);
   * mu plus the drag between the walls and the band: the equation above, with n(y) 3 pi eta d from
     each bin's volume fraction (the species mixed as `particles.mix` says, in every bin alike) and
     u_x(y) the bin's mean over the particles centred in it (a bin without centres takes its
@@ -110,6 +111,36 @@ def boyer_less_fluid(J):
     return BOYER_LAWS["mu"](J) - J
 
 
+# The two terms of Boyer et al.'s mu(J) besides J: the contact term and the hydrodynamic one.
+def boyer_contact_term(J):
+    return 0.32 + 0.38 / (1.0 + 0.005 / J)
+
+
+def boyer_hydrodynamic_term(J):
+    return 2.5 * 0.585 * math.sqrt(J)
+
+
+def print_split(by_j):
+    """Spheres: the bulk's sigma_xy split into the contacts' and the lubrication's parts, each
+    beside the term of Boyer et al.'s fit that stands for it. For orientation only: their split is
+    a fitting form, and their hydrodynamic term holds all the fluid's stress between particles
+    (the one-body stresslet and the many-body far field too), of which lubrication is a part."""
+    rows = {J: [x for _, x in pts if x[7] is not None] for J, pts in by_j.items()}
+    rows = {J: r for J, r in rows.items() if r}
+    if not rows:
+        return
+    print()
+    print("| J | points | contact part / P | Boyer's contact term | ratio | lubrication part / P | "
+          "Boyer's (5/2) phi_m J^1/2 | ratio |")
+    print("|---|---|---|---|---|---|---|---|")
+    for J in sorted(rows):
+        (con, con_e), (lub, lub_e) = (rundir.mean_sem(c) for c in
+                                      ([x[2] - x[7] for x in rows[J]], [x[7] for x in rows[J]]))
+        bc, bh = boyer_contact_term(J), boyer_hydrodynamic_term(J)
+        print(f"| {J:g} | {len(rows[J])} | {pm(con, con_e)} | {bc:.3g} | {con / bc:.3f} | "
+              f"{pm(lub, lub_e)} | {bh:.3g} | {lub / bh:.3f} |")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("stores", nargs="+", type=pathlib.Path)
@@ -163,6 +194,8 @@ def main():
             ref, less = BOYER_LAWS["mu"](J), boyer_less_fluid(J)
             row += f" {ref:.3g} | {less:.3g} | {bulk / ref:.3f} | {bulk / less:.3f} |"
         print(row)
+    if spheres:
+        print_split(by_j)
 
 
 if __name__ == "__main__":

@@ -82,7 +82,8 @@ write_point(spheres, "seed=1", 3, "volume", c3, lubrication_band=0.4)
 write_point(spheres, "seed=2", 3, "volume", c3, stationary=False, sxy_band=5.0)
 r = run(spheres)
 assert r.returncode == 0, r.stderr
-cells = row_cells(r.stdout, "0.05")
+# Spheres print two tables: the stresses, then their split against Boyer et al.'s terms.
+cells = row_cells(r.stdout.split("\n\n")[0], "0.05")
 assert cells[1] == "1", f"the drifting point must not count: {cells}"
 assert abs(float(cells[3]) - 0.9) < 1e-9, cells
 assert abs(float(cells[4]) - expected(c3)) < 1.5e-3, (cells, expected(c3))
@@ -90,6 +91,14 @@ assert abs(expected(c3) - mu_top) > 0.1, "the drag term must be large enough to 
 boyer = 0.32 + 0.38 / (1 + 0.005 / J) + J + 2.5 * 0.585 * J ** 0.5
 assert cells[5] == "0.4 (1)", f"the band's lubrication part, from the one point: {cells}"
 assert abs(float(cells[9]) - 0.9 / (boyer - J)) < 1e-3, cells
+# The split table: the contacts' part is the band's pair stress less its lubrication part, each
+# beside its term of the fit.
+cells = row_cells(r.stdout.split("\n\n")[1], "0.05")
+contact_term, hydro_term = 0.32 + 0.38 / (1 + 0.005 / J), 2.5 * 0.585 * J ** 0.5
+assert cells[1] == "1" and abs(float(cells[2]) - 0.5) < 1e-9, cells
+assert abs(float(cells[3]) - contact_term) < 1e-3 * contact_term, cells
+assert abs(float(cells[4]) - 0.5 / contact_term) < 1e-3, cells
+assert abs(float(cells[5]) - 0.4) < 1e-9 and abs(float(cells[7]) - 0.4 / hydro_term) < 1e-3, cells
 
 # The check of --points: the drag over the whole gap is the walls' difference (the synthetic
 # walls were set so), the mean of the two walls' estimates being blind to which wall is which.
@@ -105,7 +114,7 @@ r = subprocess.run([sys.executable, str(repo / "tools/wall_stress.py"), "--point
                     "--include-not-stationary", str(spheres)], capture_output=True, text=True)
 assert r.returncode == 0, r.stderr
 assert len(row_cells(r.stdout, "spheres/seed=2 (not stationary)")) == 8, r.stdout
-assert row_cells(r.stdout, "0.05")[1] == "2", r.stdout
+assert row_cells(r.stdout.split("\n\n")[1], "0.05")[1] == "2", r.stdout
 
 # Discs mixed by volume (1.4^3 small discs to a large one) in a monolayer of thickness 1.5:
 # the species' area fractions are their numbers times their areas.
