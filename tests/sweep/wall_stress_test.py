@@ -91,14 +91,27 @@ assert abs(expected(c3) - mu_top) > 0.1, "the drag term must be large enough to 
 boyer = 0.32 + 0.38 / (1 + 0.005 / J) + J + 2.5 * 0.585 * J ** 0.5
 assert cells[5] == "0.4 (1)", f"the band's lubrication part, from the one point: {cells}"
 assert abs(float(cells[9]) - 0.9 / (boyer - J)) < 1e-3, cells
-# The split table: the contacts' part is the band's pair stress less its lubrication part, each
-# beside its term of the fit.
+# The split table (the second): the contacts' part is the band's pair stress less its
+# lubrication part, each beside its term of the fit at J = 0.05 (0.32 + 0.38 / 1.1 and
+# 2.5 x 0.585 x 0.05^1/2).
+contact_term, hydro_term = 0.665455, 0.327025
 cells = row_cells(r.stdout.split("\n\n")[1], "0.05")
-contact_term, hydro_term = 0.32 + 0.38 / (1 + 0.005 / J), 2.5 * 0.585 * J ** 0.5
 assert cells[1] == "1" and abs(float(cells[2]) - 0.5) < 1e-9, cells
-assert abs(float(cells[3]) - contact_term) < 1e-3 * contact_term, cells
+assert abs(float(cells[3]) - contact_term) < 1e-3, cells
 assert abs(float(cells[4]) - 0.5 / contact_term) < 1e-3, cells
 assert abs(float(cells[5]) - 0.4) < 1e-9 and abs(float(cells[7]) - 0.4 / hydro_term) < 1e-3, cells
+
+# Points with and without the split at one J: the split is each point's own difference, over
+# the points that have one (a split of the means over all points would read 0.767 here).
+mixed = work / "mixed"
+write_point(mixed, "seed=1", 3, "volume", c3, lubrication_band=0.4)
+write_point(mixed, "seed=2", 3, "volume", c3, sxy_band=1.5)
+write_point(mixed, "seed=3", 3, "volume", c3, sxy_band=0.8, lubrication_band=0.2)
+r = run(mixed)
+assert r.returncode == 0, r.stderr
+cells = row_cells(r.stdout.split("\n\n")[1], "0.05")
+assert cells[1] == "2", cells
+assert cells[2].startswith("0.55 +- 0.05") and cells[5].startswith("0.3 +- 0.1"), cells
 
 # The check of --points: the drag over the whole gap is the walls' difference (the synthetic
 # walls were set so), the mean of the two walls' estimates being blind to which wall is which.
