@@ -236,8 +236,18 @@ SEED_LAWS = {"phi": lambda J: 0.81 - 0.64 * math.sqrt(J), "D": lambda J: 0.024 *
 
 # Boyer, Guazzelli & Pouliquen, Phys. Rev. Lett. 107, 188301 (2011): spheres in pressure-imposed
 # shear; phi_m = 0.585, mu_1 = 0.32, mu_2 = 0.7, J_0 = 0.005.
+def boyer_contact_term(J):
+    """Boyer et al.'s mu_1 + (mu_2 - mu_1) / (1 + J_0 / J): the contact term of their mu(J)."""
+    return 0.32 + 0.38 / (1.0 + 0.005 / J)
+
+
+def boyer_hydrodynamic_term(J):
+    """Boyer et al.'s (5/2) phi_m J^1/2: the hydrodynamic term of their mu(J)."""
+    return 2.5 * 0.585 * math.sqrt(J)
+
+
 BOYER_LAWS = {"phi": lambda J: 0.585 / (1.0 + math.sqrt(J)),
-              "mu": lambda J: 0.32 + 0.38 / (1.0 + 0.005 / J) + J + 2.5 * 0.585 * math.sqrt(J)}
+              "mu": lambda J: boyer_contact_term(J) + J + boyer_hydrodynamic_term(J)}
 
 
 def against_boyer(rows, heading=True):

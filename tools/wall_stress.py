@@ -37,7 +37,7 @@ import pathlib
 import sys
 
 import rundir
-from results_table import BOYER_LAWS, fmt, pm
+from results_table import BOYER_LAWS, boyer_contact_term, boyer_hydrodynamic_term, fmt, pm
 
 
 def drag_coefficient(cfg):
@@ -109,15 +109,6 @@ def point_stresses(run):
 
 def boyer_less_fluid(J):
     return BOYER_LAWS["mu"](J) - J
-
-
-# The two terms of Boyer et al.'s mu(J) besides J: the contact term and the hydrodynamic one.
-def boyer_contact_term(J):
-    return 0.32 + 0.38 / (1.0 + 0.005 / J)
-
-
-def boyer_hydrodynamic_term(J):
-    return 2.5 * 0.585 * math.sqrt(J)
 
 
 def print_split(by_j):
