@@ -13,6 +13,12 @@
       consecutive windows of W strain: the window means and the verdict of the same four
       signals as the run's own test, so that the strain at which a start reaches steady state
       can be read off.
+
+  stationarity_check.py blocks RUN_DIR...
+      A finished run's measured window block by block, from its summary.json alone (no
+      trajectory): the block means its error bars and its verdict were formed from
+      (`window_blocks`), and H_change, the least-squares line through the H column times the
+      window. Runs finished before sheardiff wrote `window_blocks` are named as such.
 """
 import argparse
 import math
@@ -84,6 +90,38 @@ def markdown(paths):
               + ", ".join(without) + ".")
 
 
+BLOCK_COLUMNS = ("H", "phi", "mu", "mu_top_minus_bottom", "net_drag_y", "bulk_normal_load")
+
+
+def blocks(paths):
+    """Each run's window_blocks as a table; the line through H's block means gives H_change."""
+    for path in map(pathlib.Path, paths):
+        run = rundir.Run(path)
+        if not run.finished:
+            print(f"{path}: no summary.json (not a finished run)\n")
+            continue
+        s = run.summary
+        b = s.get("window_blocks")
+        if not b:
+            print(f"{path}: no window_blocks (a run finished before sheardiff wrote them, "
+                  "or one without a steady window)\n")
+            continue
+        verdict = ("stationary" if s.get("stationary")
+                   else "DRIFTING: " + s.get("not_stationary", "?"))
+        print(f"{path}: {len(b['strain'])} blocks, verdict {verdict}, H_change "
+              f"{s.get('H_change', math.nan):+.3f} +- {s.get('H_change_err', math.nan):.3f} d")
+        print("strain | " + " | ".join(BLOCK_COLUMNS))
+        for k, t in enumerate(b["strain"]):
+            cells = ["-" if b.get(c) is None else f"{b[c][k]:.4f}" for c in BLOCK_COLUMNS]
+            print(f"{t:7.2f} | " + " | ".join(cells))
+        if b.get("H") is not None:
+            slope = np.polyfit(np.asarray(b["strain"]), np.asarray(b["H"]), 1)[0]
+            span = len(b["strain"]) * (b["strain"][1] - b["strain"][0]) if len(b["strain"]) > 1 else 0
+            print(f"line through H's block means: {slope:+.4f} d per strain, {slope * span:+.3f} d "
+                  "over the window")
+        print()
+
+
 def block_stats(x, t, lo, hi, blocks):
     edges = np.linspace(lo, hi, blocks + 1)
     means = []
@@ -147,6 +185,8 @@ def main():
     s = sub.add_parser("store")
     s.add_argument("results", nargs="+")
     s.add_argument("--markdown", action="store_true")
+    b = sub.add_parser("blocks")
+    b.add_argument("runs", nargs="+")
     a = sub.add_parser("approach")
     a.add_argument("run")
     a.add_argument("--window", type=float, default=10.0)
@@ -160,6 +200,8 @@ def main():
         else:
             for path in args.results:
                 store(path)
+    elif args.what == "blocks":
+        blocks(args.runs)
     else:
         if not (args.window > 0 and args.block > 0 and args.z > 0 and args.tolerance > 0):
             sys.exit("stationarity_check.py: --window, --block, --z and --tolerance must be > 0")

@@ -186,6 +186,11 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "with midpoints in it); passes within `steady.bulk_load_tolerance` of 1"},
            {sk::bulk_normal_load_err, "P",
             "standard error of that mean (batch means; reported, not used in the verdict)"},
+           {sk::window_blocks, "-",
+            "object of arrays, one entry per time block of the window (the blocks of the errors "
+            "and of H_change): `strain` (block midpoints), and the block means of `H` (d), `phi`, "
+            "`mu`, `mu_top_minus_bottom`, `net_drag_y` (P) and `bulk_normal_load` (P); a signal "
+            "the run did not record, or with an empty block, is null"},
        }},
       {"The pressure cell: profiles across the gap",
        "Time averages over the measured window, weighted by dt, in bins of "

@@ -243,6 +243,7 @@ void add_window_keys(const std::filesystem::path& traj, const Config& cfg,
                   signals ? series("net_drag_y") : std::vector<double>{},
                   signals ? series("bulk_normal_load") : std::vector<double>{}, from, last);
   add_steady_errors(computed, window, from, last, cfg.analysis.error_block);
+  add_window_blocks(computed, window, from, last, cfg.analysis.error_block);
   if (signals)
     add_stationarity(computed, pressure_cell_stationarity(cfg.steady, window, from, last,
                                                           cfg.analysis.error_block));

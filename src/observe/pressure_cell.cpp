@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/analysis/uncertainty.hpp"
@@ -91,6 +93,32 @@ StationarityVerdict pressure_cell_stationarity(const SteadyStateParams& cfg,
   v.signals.push_back(mean_within_tolerance(
       summary_key::bulk_normal_load, means(CellSignal::bulk_load), 1.0, cfg.bulk_load_tolerance));
   return v;
+}
+
+void add_window_blocks(nlohmann::json& js, const BinnedSeries& window, double from, double to,
+                       double block) {
+  if (!(to > from) || window.samples() < kMinWindowFrames) return;
+  const long blocks = std::max(4L, static_cast<long>((to - from) / block));
+  const double width = (to - from) / static_cast<double>(blocks);
+  std::vector<double> mid(static_cast<std::size_t>(blocks));
+  for (long k = 0; k < blocks; ++k)
+    mid[static_cast<std::size_t>(k)] = from + (static_cast<double>(k) + 0.5) * width;
+  nlohmann::json out;
+  out["strain"] = mid;
+  const std::pair<const char*, std::size_t> signals[] = {
+      {"H", CellSignal::h},
+      {"phi", CellSignal::phi},
+      {"mu", CellSignal::mu},
+      {"mu_top_minus_bottom", CellSignal::mu_difference},
+      {"net_drag_y", CellSignal::net_drag_y},
+      {"bulk_normal_load", CellSignal::bulk_load}};
+  for (const auto& [name, s] : signals) {
+    const BatchMeans b = batch_means(window, s, from, to, blocks);
+    // batch_means leaves out blocks without values: the means then no longer line up with the
+    // strains, so the signal is null rather than shifted.
+    out[name] = b.blocks == blocks ? nlohmann::json(b.block_means) : nlohmann::json(nullptr);
+  }
+  js[summary_key::window_blocks] = out;
 }
 
 void add_stationarity(nlohmann::json& js, const StationarityVerdict& v) {
@@ -280,6 +308,7 @@ void PressureCellObserverOf<D>::finish(const Dynamics& d, nlohmann::json& js, H5
   // The window's blocks span its frames, first to last: what `sheardiff analyse` sees too.
   const double last = window_.samples() == 0 ? d.strain() : window_.last_time();
   add_steady_errors(js, window_, steady_at_, last, error_block_);
+  add_window_blocks(js, window_, steady_at_, last, error_block_);
   add_stationarity(
       js, pressure_cell_stationarity(steady_cfg_, window_, steady_at_, last, error_block_));
   (void)writer;

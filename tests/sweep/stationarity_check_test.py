@@ -34,3 +34,25 @@ assert rows[1].startswith("| a | J=0.02_seed=1 | 0.5012 |") and rows[1].endswith
 assert lines[-1].startswith("No stationarity verdict recorded") and "b/points" not in lines[-1] \
     and lines[-1].rstrip(".").endswith("b/J=0.1_seed=1"), lines[-1]
 print("stationarity_check: --markdown rows, order and the points without a verdict as expected")
+
+# blocks: a run's window_blocks printed block by block, with the line through H's block means
+# (here H rises 0.05 d a block of 2 strains: 0.025 d per strain, 0.2 d over the 8-strain
+# window); a run without them and an unfinished one are named as such.
+blocked = work / "blocked"
+blocked.mkdir(parents=True, exist_ok=True)
+(blocked / "summary.json").write_text(json.dumps(dict(signals, stationary=True, window_blocks={
+    "strain": [11.0, 13.0, 15.0, 17.0], "H": [20.0, 20.05, 20.1, 20.15], "phi": None,
+    "mu": [0.5, 0.51, 0.49, 0.5], "mu_top_minus_bottom": [0.0, 0.01, -0.01, 0.0],
+    "net_drag_y": [0.0, 0.0, 0.0, 0.0], "bulk_normal_load": [1.0, 1.01, 0.99, 1.0]})))
+unfinished = work / "unfinished"
+unfinished.mkdir(parents=True, exist_ok=True)
+out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
+                      str(blocked), str(work / "a/points/J=0.02_seed=1"), str(unfinished)],
+                     capture_output=True, text=True, check=True).stdout
+lines = out.splitlines()
+assert lines[0].startswith(f"{blocked}: 4 blocks, verdict stationary"), out
+assert lines[2] == "  11.00 | 20.0000 | - | 0.5000 | 0.0000 | 0.0000 | 1.0000", out
+assert "+0.0250 d per strain, +0.200 d over the window" in out, out
+assert f"{work / 'a/points/J=0.02_seed=1'}: no window_blocks" in out, out
+assert f"{unfinished}: no summary.json" in out, out
+print("stationarity_check: blocks prints the window block by block and its line")

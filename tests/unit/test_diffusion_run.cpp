@@ -148,6 +148,7 @@ TEST(DiffusionRun, AnalyseReproducesThePressureCellExactly) {
   ASSERT_TRUE(during["steady"].get<bool>());
   ASSERT_TRUE(during["phi_err"].is_number()) << during.dump();
   ASSERT_TRUE(during.contains("mu_top_minus_bottom_err"));
+  ASSERT_TRUE(during.contains("window_blocks"));
   const std::string before = file_text(dir / "summary.json");
   const auto h5_time = std::filesystem::last_write_time(dir / "analysis.h5");
   const Reanalysis re = reanalyse_run(dir);

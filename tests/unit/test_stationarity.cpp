@@ -179,3 +179,47 @@ TEST(Stationarity, PressureCellWindowOfLayoutSixIsBinnedOnReading) {
   EXPECT_EQ(sd::batch_means(again.window(), sd::CellSignal::mu, kFrom, t.back(), kBlocks).err,
             sd::batch_means(cell.window(), sd::CellSignal::mu, kFrom, t.back(), kBlocks).err);
 }
+
+// window_blocks shows what the verdict weighed: a noiseless H that rises 0.1 d per strain gives
+// block means on the line at the blocks' midpoints (a block mean of a linear signal sampled
+// evenly is its value at the blocks' mean frame time, within a frame's rise of the midpoint's:
+// 0.002 d), and the least-squares line through them is H_change; a signal the run did not record
+// is null, not shifted.
+TEST(Stationarity, WindowBlocksAreTheMeansTheVerdictUses) {
+  const auto t = times();
+  std::vector<double> h, top, bottom, drag, load;
+  for (double s : t) {
+    h.push_back(40.0 + 0.1 * (s - kFrom));
+    top.push_back(0.6), bottom.push_back(0.4), drag.push_back(0.0), load.push_back(1.0);
+  }
+  const sd::BinnedSeries w = sd::cell_window(t, h, {}, top, bottom, drag, load, kFrom, kTo);
+  nlohmann::json js;
+  sd::add_window_blocks(js, w, kFrom, kTo, 3.0);
+  const auto& b = js.at("window_blocks");
+  ASSERT_EQ(b.at("strain").size(), static_cast<std::size_t>(kBlocks));
+  ASSERT_EQ(b.at("H").size(), static_cast<std::size_t>(kBlocks));
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlocks); ++k) {
+    const double mid = kFrom + (static_cast<double>(k) + 0.5) * 3.0;
+    EXPECT_NEAR(b.at("strain")[k].get<double>(), mid, 1e-12);
+    EXPECT_NEAR(b.at("H")[k].get<double>(), 40.0 + 0.1 * (mid - kFrom), 2e-3) << k;
+    EXPECT_NEAR(b.at("mu")[k].get<double>(), 0.5, 1e-12);
+    EXPECT_NEAR(b.at("mu_top_minus_bottom")[k].get<double>(), 0.2, 1e-12);
+    EXPECT_NEAR(b.at("bulk_normal_load")[k].get<double>(), 1.0, 1e-12);
+  }
+  EXPECT_TRUE(b.at("phi").is_null());
+  const auto v = sd::pressure_cell_stationarity(sd::SteadyStateParams{}, w, kFrom, kTo, 3.0);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlocks); ++k) {
+    const double x = b.at("strain")[k].get<double>(), y = b.at("H")[k].get<double>();
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double n = kBlocks, slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  EXPECT_NEAR(v.signals[2].value, slope * (kTo - kFrom), 1e-9);
+  EXPECT_NEAR(v.signals[2].value, 3.0, 0.01);  // 0.1 d per strain over 30 strains
+  // Too short a window: no blocks (as no error bars).
+  nlohmann::json none;
+  const sd::BinnedSeries few =
+      sd::cell_window(t, h, {}, top, bottom, drag, load, kFrom, kFrom + 0.1);
+  sd::add_window_blocks(none, few, kFrom, kFrom + 0.1, 3.0);
+  EXPECT_FALSE(none.contains("window_blocks"));
+}

@@ -86,6 +86,7 @@ inline constexpr const char* H_change = "H_change";
 inline constexpr const char* H_change_err = "H_change_err";
 inline constexpr const char* bulk_normal_load = "bulk_normal_load";
 inline constexpr const char* bulk_normal_load_err = "bulk_normal_load_err";
+inline constexpr const char* window_blocks = "window_blocks";
 
 // The pressure cell: profiles across the gap (src/observe/profiles.cpp)
 inline constexpr const char* profile_bin = "profile_bin";

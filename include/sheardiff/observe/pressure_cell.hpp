@@ -42,6 +42,11 @@ StationarityVerdict pressure_cell_stationarity(const SteadyStateParams& cfg,
 // Its signals into summary.json: stationary, not_stationary (the failed signals), and each
 // signal's value and error (net_drag_y, mu_top_minus_bottom, H_change, bulk_normal_load).
 void add_stationarity(nlohmann::json& js, const StationarityVerdict& v);
+// The block means the errors and the verdict are formed from (window_blocks in summary.json),
+// so that a reader can see a drift the verdict weighed, or one it let pass, without the
+// trajectory. Blocks as in add_steady_errors; nothing for a window of fewer than 8 frames.
+void add_window_blocks(nlohmann::json& js, const BinnedSeries& window, double from, double to,
+                       double block);
 
 // Observables of the pressure-imposed plane shear cell (docs/model.md section 9): gap H, bulk phi,
 // mu = tau / P and the measured pressure from the wall forces, steady-state detection from the
