@@ -17,8 +17,9 @@
   stationarity_check.py blocks RUN_DIR...
       A finished run's measured window block by block, from its summary.json alone (no
       trajectory): the block means its error bars and its verdict were formed from
-      (`window_blocks`), and H_change, the least-squares line through the H column times the
-      window. Runs finished before sheardiff wrote `window_blocks` are named as such.
+      (`window_blocks`), and the least-squares lines through H's (the run's H_change) and phi's
+      block means, each as its change over the window +- its standard error. Runs finished
+      before sheardiff wrote `window_blocks` are named as such.
 """
 import argparse
 import math
@@ -93,8 +94,27 @@ def markdown(paths):
 BLOCK_COLUMNS = ("H", "phi", "mu", "mu_top_minus_bottom", "net_drag_y", "bulk_normal_load")
 
 
+def fmt_num(x, spec):
+    """x formatted, or '-' where the summary holds null (an empty block) or NaN."""
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+
+
+def window_line(t, y):
+    """The least-squares line through block means y at midpoints t: its change over the window
+    (slope x window length, as the run's H_change) and that change's standard error from the
+    scatter about the line, the run's own estimate (src/analysis/stationarity.cpp)."""
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    span = len(t) * (t[1] - t[0])
+    tc = t - t.mean()
+    slope = (tc @ (y - y.mean())) / (tc @ tc)
+    resid = y - y.mean() - slope * tc
+    err = math.sqrt((resid @ resid) / (len(t) - 2) / (tc @ tc)) if len(t) > 2 else math.nan
+    return slope * span, err * span
+
+
 def blocks(paths):
-    """Each run's window_blocks as a table; the line through H's block means gives H_change."""
+    """Each run's window_blocks as a table, and the lines through H's and phi's block means (the
+    first is the run's H_change)."""
     for path in map(pathlib.Path, paths):
         run = rundir.Run(path)
         if not run.finished:
@@ -106,19 +126,22 @@ def blocks(paths):
             print(f"{path}: no window_blocks (a run finished before sheardiff wrote them, "
                   "or one without a steady window)\n")
             continue
-        verdict = ("stationary" if s.get("stationary")
-                   else "DRIFTING: " + s.get("not_stationary", "?"))
+        if "stationary" not in s:
+            verdict = "no verdict (a run recorded before the stationarity signals)"
+        else:
+            verdict = ("stationary" if s["stationary"]
+                       else "DRIFTING: " + (s.get("not_stationary") or "?"))
         print(f"{path}: {len(b['strain'])} blocks, verdict {verdict}, H_change "
-              f"{s.get('H_change', math.nan):+.3f} +- {s.get('H_change_err', math.nan):.3f} d")
+              f"{fmt_num(s.get('H_change'), '+.3f')} +- {fmt_num(s.get('H_change_err'), '.3f')} d")
         print("strain | " + " | ".join(BLOCK_COLUMNS))
         for k, t in enumerate(b["strain"]):
-            cells = ["-" if b.get(c) is None else f"{b[c][k]:.4f}" for c in BLOCK_COLUMNS]
+            cells = ["-" if b.get(c) is None else fmt_num(b[c][k], ".4f") for c in BLOCK_COLUMNS]
             print(f"{t:7.2f} | " + " | ".join(cells))
-        if b.get("H") is not None:
-            slope = np.polyfit(np.asarray(b["strain"]), np.asarray(b["H"]), 1)[0]
-            span = len(b["strain"]) * (b["strain"][1] - b["strain"][0]) if len(b["strain"]) > 1 else 0
-            print(f"line through H's block means: {slope:+.4f} d per strain, {slope * span:+.3f} d "
-                  "over the window")
+        for name, unit in (("H", " d"), ("phi", "")):
+            if b.get(name) is not None and len(b["strain"]) > 1:
+                change, err = window_line(b["strain"], b[name])
+                print(f"line through {name}'s block means: {fmt_num(change, '+.4f')} +- "
+                      f"{fmt_num(err, '.4f')}{unit} over the window")
         print()
 
 

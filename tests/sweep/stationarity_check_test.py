@@ -37,22 +37,34 @@ print("stationarity_check: --markdown rows, order and the points without a verdi
 
 # blocks: a run's window_blocks printed block by block, with the line through H's block means
 # (here H rises 0.05 d a block of 2 strains: 0.025 d per strain, 0.2 d over the 8-strain
-# window); a run without them and an unfinished one are named as such.
+# window, exactly, so with no scatter about the line); a null H_change and a run without a
+# verdict print as such, not as an error; a run without window_blocks and an unfinished one
+# are named as such.
 blocked = work / "blocked"
 blocked.mkdir(parents=True, exist_ok=True)
 (blocked / "summary.json").write_text(json.dumps(dict(signals, stationary=True, window_blocks={
     "strain": [11.0, 13.0, 15.0, 17.0], "H": [20.0, 20.05, 20.1, 20.15], "phi": None,
     "mu": [0.5, 0.51, 0.49, 0.5], "mu_top_minus_bottom": [0.0, 0.01, -0.01, 0.0],
     "net_drag_y": [0.0, 0.0, 0.0, 0.0], "bulk_normal_load": [1.0, 1.01, 0.99, 1.0]})))
+noverdict = work / "noverdict"
+noverdict.mkdir(parents=True, exist_ok=True)
+(noverdict / "summary.json").write_text(json.dumps({"H_change": None, "window_blocks": {
+    "strain": [1.0, 3.0, 5.0, 7.0], "H": [20.0, 20.0, 20.0, 20.0], "phi": [0.5, None, 0.5, 0.5],
+    "mu": None, "mu_top_minus_bottom": None, "net_drag_y": None, "bulk_normal_load": None}}))
 unfinished = work / "unfinished"
 unfinished.mkdir(parents=True, exist_ok=True)
 out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
-                      str(blocked), str(work / "a/points/J=0.02_seed=1"), str(unfinished)],
+                      str(blocked), str(work / "a/points/J=0.02_seed=1"), str(noverdict),
+                      str(unfinished)],
                      capture_output=True, text=True, check=True).stdout
 lines = out.splitlines()
 assert lines[0].startswith(f"{blocked}: 4 blocks, verdict stationary"), out
 assert lines[2] == "  11.00 | 20.0000 | - | 0.5000 | 0.0000 | 0.0000 | 1.0000", out
-assert "+0.0250 d per strain, +0.200 d over the window" in out, out
+assert "line through H's block means: +0.2000 +- 0.0000 d over the window" in out, out
+# phi is null: no line for it.
+assert "line through phi's" not in out.split("\n\n")[0], out
 assert f"{work / 'a/points/J=0.02_seed=1'}: no window_blocks" in out, out
 assert f"{unfinished}: no summary.json" in out, out
+assert f"{noverdict}: 4 blocks, verdict no verdict" in out and "H_change - +- - d" in out, out
+assert "   3.00 | 20.0000 | - | - | - | - | -" in out, out
 print("stationarity_check: blocks prints the window block by block and its line")

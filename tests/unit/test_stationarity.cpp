@@ -216,6 +216,23 @@ TEST(Stationarity, WindowBlocksAreTheMeansTheVerdictUses) {
   const double n = kBlocks, slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
   EXPECT_NEAR(v.signals[2].value, slope * (kTo - kFrom), 1e-9);
   EXPECT_NEAR(v.signals[2].value, 3.0, 0.01);  // 0.1 d per strain over 30 strains
+  // A window that is not a whole number of blocks (29 strain: 9 blocks of 29/9) and one of 1
+  // strain (at least 4 blocks, here of 0.25): the midpoints follow the blocks' own width.
+  for (const double to : {32.0, kFrom + 1.0}) {
+    const sd::BinnedSeries part = sd::cell_window(t, h, {}, top, bottom, drag, load, kFrom, to);
+    nlohmann::json pj;
+    sd::add_window_blocks(pj, part, kFrom, to, 3.0);
+    const auto& pb = pj.at("window_blocks");
+    const std::size_t n = to == 32.0 ? 9 : 4;
+    const double width = (to - kFrom) / static_cast<double>(n);
+    ASSERT_EQ(pb.at("strain").size(), n) << to;
+    ASSERT_EQ(pb.at("H").size(), n) << to;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double mid = kFrom + (static_cast<double>(k) + 0.5) * width;
+      EXPECT_NEAR(pb.at("strain")[k].get<double>(), mid, 1e-12) << to;
+      EXPECT_NEAR(pb.at("H")[k].get<double>(), 40.0 + 0.1 * (mid - kFrom), 2e-3) << to << " " << k;
+    }
+  }
   // Too short a window: no blocks (as no error bars).
   nlohmann::json none;
   const sd::BinnedSeries few =
