@@ -149,6 +149,26 @@ TEST(DiffusionRun, AnalyseReproducesThePressureCellExactly) {
   ASSERT_TRUE(during["phi_err"].is_number()) << during.dump();
   ASSERT_TRUE(during.contains("mu_top_minus_bottom_err"));
   ASSERT_TRUE(during.contains("window_blocks"));
+  {
+    // The run's H_change is the least-squares line through the H block means it reports,
+    // times the window (blocks of equal width, so the window is their count times the spacing).
+    const auto& b = during["window_blocks"];
+    const std::size_t n = b["strain"].size();
+    ASSERT_GE(n, 4u);
+    ASSERT_EQ(b["H"].size(), n);
+    double tm = 0, hm = 0;
+    for (std::size_t k = 0; k < n; ++k)
+      tm += b["strain"][k].get<double>(), hm += b["H"][k].get<double>();
+    tm /= static_cast<double>(n), hm /= static_cast<double>(n);
+    double sxy = 0, sxx = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double dt = b["strain"][k].get<double>() - tm;
+      sxy += dt * (b["H"][k].get<double>() - hm), sxx += dt * dt;
+    }
+    const double span =
+        static_cast<double>(n) * (b["strain"][1].get<double>() - b["strain"][0].get<double>());
+    EXPECT_NEAR(during["H_change"].get<double>(), sxy / sxx * span, 1e-9);
+  }
   const std::string before = file_text(dir / "summary.json");
   const auto h5_time = std::filesystem::last_write_time(dir / "analysis.h5");
   const Reanalysis re = reanalyse_run(dir);
