@@ -19,9 +19,11 @@ only; the seed's laws dashed black.
 
 A sweep of spheres (sweep.csv's dimension = 3) draws Boyer, Guazzelli & Pouliquen's (2011) fits
 in (d) and (i), the 3D experiments' phi(J) and mu(J); the seed's laws stay in the other panels
-as the 2D reference ("2D seed").
+as the 2D reference ("2D seed"). --discs STORE draws a discs' fitted store (its fits.json: the
+per-J means over seeds, e.g. results/table1_n1000) in grey in (c), (f) and (i), so that the
+spheres' D, dv, Psi and mu stand beside this code's discs, not only beside the seed's laws.
 
-    /usr/bin/python3 tools/plot_sweep.py DIR [--out DIR/sweep.png]
+    /usr/bin/python3 tools/plot_sweep.py DIR [--out DIR/sweep.png] [--discs STORE]
 """
 import argparse
 import json
@@ -71,7 +73,11 @@ def main():
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("sweep", type=pathlib.Path)
     ap.add_argument("--out", type=pathlib.Path)
+    ap.add_argument("--discs", type=pathlib.Path,
+                    help="a discs' store with fits.json, drawn in grey in (c), (f) and (i)")
     args = ap.parse_args()
+    if args.discs is not None and not (args.discs / "fits.json").exists():
+        sys.exit(f"--discs {args.discs}: no fits.json (a store that `sheardiff fit` wrote)")
     for f in ("fits.json", "sweep.csv"):
         if not (args.sweep / f).exists():
             sys.exit(f"{args.sweep}: no {f} (run `sheardiff sweep SWEEP.toml --out DIR --collect` "
@@ -192,6 +198,25 @@ def main():
             jj = np.logspace(np.log10(J.min()), np.log10(J.max()), 40)
             ax[8].semilogx(jj, mf["mu_c"] + mf["a"] * jj ** mf["b"], "-", color=c, lw=0.9,
                            label=f"fit: {mf['mu_c']:.3f} + {mf['a']:.2f} J^{mf['b']:.2f}")
+
+    if args.discs is not None:
+        discs = json.loads((args.discs / "fits.json").read_text())
+        grey, drawn = "0.55", 0
+        for g in discs["groups"]:
+            rr = sorted(g["rows"], key=lambda r: r["J"])
+            J = np.array([r["J"] for r in rr])
+
+            def dget(k):
+                return np.array([r.get(k) if r.get(k) is not None else np.nan for r in rr], float)
+
+            lab = f"discs ({args.discs.name})"
+            errbar(ax[2], J, dget("D"), dget("D_sem"), dget("D_run_err"), grey, "s", lab)
+            errbar(ax[5], J, dget("dv"), dget("dv_sem"), dget("dv_run_err"), grey, "s", f"dv, {lab}")
+            errbar(ax[5], J, dget("psi"), dget("psi_sem"), dget("psi_run_err"), grey, "v",
+                   f"Psi, {lab}")
+            errbar(ax[8], J, dget("mu"), dget("mu_sem"), dget("mu_run_err"), grey, "s", lab)
+            drawn += len(J)
+        print(f"--discs: {drawn} J of {args.discs} drawn in (c), (f) and (i)")
 
     # Per-point panels from sweep.csv: step length and the Psi definitions.
     pts = {}
