@@ -60,6 +60,12 @@ def series_label(axes):
                      for k, v in axes.items()) or "all points"
 
 
+def column(rows, k):
+    """A fits.json group's rows' values of k as floats, NaN where absent."""
+    import numpy as np
+    return np.array([r.get(k) if r.get(k) is not None else np.nan for r in rows], float)
+
+
 def num(r, k):
     v = r.get(k)
     try:
@@ -162,7 +168,7 @@ def main():
         J = np.array([r["J"] for r in rr])
 
         def get(k):
-            return np.array([r.get(k) if r.get(k) is not None else np.nan for r in rr], float)
+            return column(rr, k)
 
         f = g["fits"]
         errbar(ax[2], J, get("D"), get("D_sem"), get("D_run_err"), c, m, lab)
@@ -207,7 +213,7 @@ def main():
             J = np.array([r["J"] for r in rr])
 
             def dget(k):
-                return np.array([r.get(k) if r.get(k) is not None else np.nan for r in rr], float)
+                return column(rr, k)
 
             lab = f"discs ({args.discs.name})"
             errbar(ax[2], J, dget("D"), dget("D_sem"), dget("D_run_err"), grey, "s", lab)

@@ -99,12 +99,13 @@ def fmt_num(x, spec):
     return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
-def window_line(t, y):
+def window_line(t, y, span=None):
     """The least-squares line through block means y at midpoints t: its change over the window
     (slope x window length, as the run's H_change) and that change's standard error from the
-    scatter about the line, the run's own estimate (src/analysis/stationarity.cpp)."""
+    scatter about the line, the run's own estimate (src/analysis/stationarity.cpp). span, the
+    window's length, defaults to the blocks' count times their spacing."""
     t, y = np.asarray(t, float), np.asarray(y, float)
-    span = len(t) * (t[1] - t[0])
+    span = len(t) * (t[1] - t[0]) if span is None else span
     tc = t - t.mean()
     slope = (tc @ (y - y.mean())) / (tc @ tc)
     resid = y - y.mean() - slope * tc
@@ -181,10 +182,7 @@ def approach(run, window, block, z, tolerance):
         dmu, dmu_e, _ = block_stats(series["mu_top"] - series["mu_bottom"], t, lo, hi, blocks)
         _, _, hb = block_stats(series["H"], t, lo, hi, blocks)
         mid = lo + (np.arange(len(hb)) + 0.5) * (window / blocks)
-        fit = np.polyfit(mid, hb, 1)
-        res = hb - np.polyval(fit, mid)
-        se = math.sqrt((res ** 2).sum() / (len(hb) - 2) / ((mid - mid.mean()) ** 2).sum())
-        hchange, hchange_e = fit[0] * window, se * window
+        hchange, hchange_e = window_line(mid, hb, window)
         load, load_e, _ = block_stats(series["bulk_normal_load"], t, lo, hi, blocks)
         if abs(drag) > z * drag_e:
             failed.append("net_drag_y")

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <random>
 
+#include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/analysis/stationarity.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 
@@ -208,12 +209,9 @@ TEST(Stationarity, WindowBlocksAreTheMeansTheVerdictUses) {
   }
   EXPECT_TRUE(b.at("phi").is_null());
   const auto v = sd::pressure_cell_stationarity(sd::SteadyStateParams{}, w, kFrom, kTo, 3.0);
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(kBlocks); ++k) {
-    const double x = b.at("strain")[k].get<double>(), y = b.at("H")[k].get<double>();
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  const double n = kBlocks, slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double slope =
+      sd::fit_line(b.at("strain").get<std::vector<double>>(), b.at("H").get<std::vector<double>>())
+          .slope;
   EXPECT_NEAR(v.signals[2].value, slope * (kTo - kFrom), 1e-9);
   EXPECT_NEAR(v.signals[2].value, 3.0, 0.01);  // 0.1 d per strain over 30 strains
   // A window that is not a whole number of blocks (29 strain: 9 blocks of 29/9) and one of 1
