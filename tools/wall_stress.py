@@ -20,7 +20,14 @@ For each point this prints, averaged over the bulk band (the profile bins at lea
     each bin's volume fraction (the species mixed as `particles.mix` says, in every bin alike) and
     u_x(y) the bin's mean over the particles centred in it (a bin without centres takes its
     nearest such bin's); the mean of the two walls' values. --points adds the drag over the
-    whole gap, which the walls' difference mu_bottom - mu_top must equal.
+    whole gap, which the walls' difference mu_bottom - mu_top must equal, and the slip at the
+    walls: the mean, weighted by phi over the bins between each wall line and the bulk band, of
+    how far the particles' u_x runs ahead of the imposed flow at the fixed wall and behind it at
+    the moving one, averaged over the two walls. The drag between the walls and the band is
+    about c J phi wall_exclusion times it, so it says where that drag comes from. For spheres it
+    adds the spacing of the walls' spheres, lx / floor(lx) in d (src/scene/pressure_shear_3d.cpp
+    lays each wall as a square lattice of spheres of diameter d filling lx x lz), which makes the
+    walls rougher the further it lies above 1.
 
 The two are independent measurements of one stress: the first from the pair forces, the second
 from the wall forces and the velocity profile. Per J: the mean over the stationary points (+- the
@@ -64,8 +71,8 @@ def drag_coefficient(cfg):
 
 def point_stresses(run):
     """(J, mu, bulk pair sigma_xy / P, mu + drag to the bulk, dimension, net drag over the gap,
-    mu_bottom - mu_top, the lubrication part of the bulk's sigma_xy / P or None) of one finished
-    point, or None without profiles."""
+    mu_bottom - mu_top, the lubrication part of the bulk's sigma_xy / P or None, slip at the walls
+    in gammadot d) of one finished point, or None without profiles."""
     s, cfg = run.summary, run.config
     need = ("profile_y", "profile_phi", "profile_u_x", "profile_shear_stress", "profile_bin",
             "profile_T")
@@ -103,8 +110,23 @@ def point_stresses(run):
     mean = lambda v: sum(v) / len(v)  # noqa: E731
     walls_plus_drag = 0.5 * (mean([from_bottom[k] for k in band]) + mean([from_top[k] for k in band]))
     lub = s.get("profile_shear_stress_lubrication")
+
+    def weighted_slip(bins, sign):
+        return sign * sum(phi[k] * slip(k) for k in bins) / sum(phi[k] for k in bins)
+
+    # slip(k) = y - u_x: ahead of the imposed flow at the fixed wall is -slip, behind it at the
+    # moving wall +slip; both positive where the profile flattens towards the walls.
+    wall_slip = 0.5 * (weighted_slip([k for k in inside if y[k] < e], -1.0)
+                       + weighted_slip([k for k in inside if y[k] > H - e], 1.0))
     return (J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag, s.get("dimension", 2),
-            below, s["mu_bottom"] - s["mu_top"], mean([lub[k] for k in band]) if lub else None)
+            below, s["mu_bottom"] - s["mu_top"], mean([lub[k] for k in band]) if lub else None,
+            wall_slip)
+
+
+def wall_spacing(summary):
+    """The centre distance of neighbouring wall spheres in d: each wall is floor(lx) spheres a
+    side on a square lattice filling lx x lz (src/scene/pressure_shear_3d.cpp, add_wall)."""
+    return summary["lx"] / max(1, math.floor(summary["lx"]))
 
 
 def boyer_less_fluid(J):
@@ -161,13 +183,16 @@ def main():
         # The drag over the whole gap is the walls' difference (x momentum of the whole cell):
         # the check that the profiles hold the drag.
         print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk | drag over the "
-              "gap / P | mu_bottom - mu_top | lubrication part of the bulk's / P |")
-        print("|---|---|---|---|---|---|---|---|")
+              "gap / P | mu_bottom - mu_top | lubrication part of the bulk's / P | slip at the walls / "
+              "(gammadot d) |" + (" walls' spacing / d |" if spheres else ""))
+        print("|---|---|---|---|---|---|---|---|---|" + ("---|" if spheres else ""))
         for J in sorted(by_j):
-            for path, (_, mu, bulk, plus, _, gap, diff, lub) in by_j[J]:
-                flag = "" if rundir.Run(path).summary.get("stationary") else " (not stationary)"
+            for path, (_, mu, bulk, plus, _, gap, diff, lub, slip) in by_j[J]:
+                summary = rundir.Run(path).summary
+                flag = "" if summary.get("stationary") else " (not stationary)"
                 print(f"| {path.parent.parent.name}/{path.name}{flag} | {J:g} | {mu:.3f} | {bulk:.3f} | "
-                      f"{plus:.3f} | {gap:+.3f} | {diff:+.3f} | {fmt(lub)} |")
+                      f"{plus:.3f} | {gap:+.3f} | {diff:+.3f} | {fmt(lub)} | {slip:+.3f} |"
+                      + (f" {wall_spacing(summary):.3f} |" if spheres else ""))
         print()
     boyer = " Boyer | Boyer less J | bulk / Boyer | bulk / (Boyer less J) |" if spheres else ""
     print("| J | points | mu (walls) | bulk sigma_xy / P (pair forces) | mu + drag to the bulk | "

@@ -5,7 +5,8 @@ f = c J phi eps (y - y0), c the mixture's 3 pi d per unit volume fraction, and t
 the drag over the whole gap. The bin under the top wall holds caps of particles but no centre
 (u_x = T = 0 there, as a run writes it): its particles move as the nearest bin's. x momentum
 balance then gives the stress at every y below it in closed form, from either wall; the tool's
-"mu + drag to the bulk" must be its mean over the bulk band's bin centres. The pair stress column
+"mu + drag to the bulk" must be its mean over the bulk band's bin centres, and the slip at the
+walls the phi-weighted mean of the profile's departure in the bins next to them. The pair stress column
 and its lubrication part must read the profiles' band means; a point whose window failed the stationarity test is left out;
 discs and spheres together are refused. Usage: wall_stress_test.py REPO WORK"""
 import json
@@ -38,7 +39,7 @@ def write_point(store, name, dimension, mix, c, lz=1.0, stationary=True, sxy_ban
     mu_bottom = mu_top + sum(drag(c)) * b  # x momentum of the whole cell
     centred = [k < edge for k in range(len(ys))]
     summary = {
-        "J": J, "H": H, "mu": 0.5 * (mu_top + mu_bottom), "mu_top": mu_top, "mu_bottom": mu_bottom,
+        "J": J, "H": H, "lx": 9.86, "mu": 0.5 * (mu_top + mu_bottom), "mu_top": mu_top, "mu_bottom": mu_bottom,
         "dimension": dimension, "stationary": stationary, "profile_bin": b, "profile_y": ys,
         "profile_phi": [phi if k < edge else (phi_edge if k == edge else 0.0)
                         for k in range(len(ys))],
@@ -121,12 +122,22 @@ assert r.returncode == 0, r.stderr
 cells = row_cells(r.stdout, "spheres/seed=1")
 assert abs(float(cells[5]) - float(cells[6])) < 1.5e-3 and abs(float(cells[6])) > 0.1, cells
 assert abs(float(cells[7]) - 0.4) < 1e-9, cells
+# The slip at the walls: the particles run ahead of the imposed flow by eps (y0 - y) below y0,
+# so over the bins below e (uniform phi) by eps (y0 - e / 2); they fall behind it by eps (y - y0)
+# above, over the bins above H - e, the edge bin (phi_edge) moving as the one below it.
+top = [k for k in range(edge) if ys[k] > H - e]
+behind = (sum(phi * eps * (ys[k] - y0) for k in top) + phi_edge * eps * (ys[edge - 1] - y0)) / (
+    phi * len(top) + phi_edge)
+wall_slip = 0.5 * (eps * (y0 - e / 2) + behind)
+assert abs(float(cells[8]) - wall_slip) < 1.5e-3 and wall_slip > 0.1, (cells, wall_slip)
+# Spheres: 9 wall spheres a side fill lx = 9.86, 1.096 d apart.
+assert cells[9] == "1.096", cells
 
 # The drifting point counts when asked, and its row says it failed the test.
 r = subprocess.run([sys.executable, str(repo / "tools/wall_stress.py"), "--points",
                     "--include-not-stationary", str(spheres)], capture_output=True, text=True)
 assert r.returncode == 0, r.stderr
-assert len(row_cells(r.stdout, "spheres/seed=2 (not stationary)")) == 8, r.stdout
+assert len(row_cells(r.stdout, "spheres/seed=2 (not stationary)")) == 10, r.stdout
 assert row_cells(r.stdout.split("\n\n")[1], "0.05")[1] == "2", r.stdout
 
 # Discs mixed by volume (1.4^3 small discs to a large one) in a monolayer of thickness 1.5:
