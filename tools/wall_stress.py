@@ -16,18 +16,23 @@ For each point this prints, averaged over the bulk band (the profile bins at lea
   * where the points measured it (profile_shear_stress_lubrication), the part of the first that the
     lubrication forces make, the rest being the contacts'; for spheres, a second table sets the
     two parts beside the contact and hydrodynamic terms of Boyer et al.'s fit (for orientation);
-  * mu plus the drag between the walls and the band: the equation above, with n(y) 3 pi eta d from
-    each bin's volume fraction (the species mixed as `particles.mix` says, in every bin alike) and
-    u_x(y) the bin's mean over the particles centred in it (a bin without centres takes its
-    nearest such bin's); the mean of the two walls' values. --points adds the drag over the
-    whole gap, which the walls' difference mu_bottom - mu_top must equal, and the slip at the
-    walls: the mean, weighted by phi over the bins between each wall line and the bulk band, of
-    how far the particles' u_x runs ahead of the imposed flow at the fixed wall and behind it at
-    the moving one, averaged over the two walls. The drag between the walls and the band is
-    about c J phi wall_exclusion times it, so it says where that drag comes from. For spheres it
-    adds the spacing of the walls' spheres, lx / floor(lx) in d (src/scene/pressure_shear_3d.cpp
-    lays each wall as a square lattice of spheres of diameter d filling lx x lz), which makes the
-    walls rougher the further it lies above 1.
+  * mu plus the drag between the walls and each height of the band: the equation above, with
+    n(y) 3 pi eta d from each bin's volume fraction (the species mixed as `particles.mix` says, in
+    every bin alike) and u_x(y) the bin's mean over the particles centred in it (a bin without
+    centres takes its nearest such bin's); the mean of the two walls' values.
+
+--points adds, per point:
+  * the part of that drag between the wall lines and the band's edges (the rest lies between the
+    band's edge and each height within it);
+  * the drag over the whole gap, which the walls' difference mu_bottom - mu_top must equal;
+  * the slip at the walls: the mean, weighted by phi over the bins between each wall line and the
+    band, of how far the particles' u_x runs ahead of the imposed flow at the fixed wall and
+    behind it at the moving one, averaged over the two walls (NaN if no bin lies there). The
+    drag next to the walls is about c J phi_w wall_exclusion times it, c the drag per unit volume
+    fraction and phi_w those bins' mean volume fraction;
+  * for spheres, the spacing of the walls' spheres, lx / floor(lx) in d
+    (src/scene/pressure_shear_3d.cpp lays each wall as a square lattice of spheres of diameter d
+    filling lx x lz): the gaps between them widen the further it lies above 1.
 
 The two are independent measurements of one stress: the first from the pair forces, the second
 from the wall forces and the velocity profile. Per J: the mean over the stationary points (+- the
@@ -39,6 +44,7 @@ suspending fluid's own stress eta gammadot, which no force of this model carries
     /usr/bin/python3 tools/wall_stress.py --include-not-stationary ...   # the failed windows too
 """
 import argparse
+import dataclasses
 import math
 import pathlib
 import sys
@@ -69,10 +75,23 @@ def drag_coefficient(cfg):
                for w, a in zip(shares, radii)) / lz
 
 
+@dataclasses.dataclass
+class PointStress:
+    """One finished point's stresses over P (velocities over gammadot, lengths in d)."""
+    J: float
+    mu: float  # the walls'
+    bulk: float  # the bulk band's pair sigma_xy
+    walls_plus_drag: float  # mu + the drag between the walls and each height of the band
+    dimension: int
+    gap_drag: float  # the drag over the whole gap
+    walls_difference: float  # mu_bottom - mu_top
+    lubrication: float | None  # the lubrication part of bulk, where measured
+    next_to_walls: float  # the part of walls_plus_drag - mu between the wall lines and the band
+    wall_slip: float  # NaN where no bin lies between a wall line and the band
+
+
 def point_stresses(run):
-    """(J, mu, bulk pair sigma_xy / P, mu + drag to the bulk, dimension, net drag over the gap,
-    mu_bottom - mu_top, the lubrication part of the bulk's sigma_xy / P or None, slip at the walls
-    in gammadot d) of one finished point, or None without profiles."""
+    """The PointStress of one finished point, or None without profiles."""
     s, cfg = run.summary, run.config
     need = ("profile_y", "profile_phi", "profile_u_x", "profile_shear_stress", "profile_bin",
             "profile_T")
@@ -110,17 +129,22 @@ def point_stresses(run):
     mean = lambda v: sum(v) / len(v)  # noqa: E731
     walls_plus_drag = 0.5 * (mean([from_bottom[k] for k in band]) + mean([from_top[k] for k in band]))
     lub = s.get("profile_shear_stress_lubrication")
+    under = [k for k in inside if y[k] < e]
+    over = [k for k in inside if y[k] > H - e]
+    # What the drag adds to the stress between each wall line and the band's edge; the rest of
+    # walls_plus_drag - mu is the drag between the band's edge and each height within it.
+    next_to_walls = 0.5 * (-sum(b * f[k] for k in under) + sum(b * f[k] for k in over))
 
     def weighted_slip(bins, sign):
-        return sign * sum(phi[k] * slip(k) for k in bins) / sum(phi[k] for k in bins)
+        weight = sum(phi[k] for k in bins)
+        return sign * sum(phi[k] * slip(k) for k in bins) / weight if weight > 0 else math.nan
 
     # slip(k) = y - u_x: ahead of the imposed flow at the fixed wall is -slip, behind it at the
     # moving wall +slip; both positive where the profile flattens towards the walls.
-    wall_slip = 0.5 * (weighted_slip([k for k in inside if y[k] < e], -1.0)
-                       + weighted_slip([k for k in inside if y[k] > H - e], 1.0))
-    return (J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag, s.get("dimension", 2),
-            below, s["mu_bottom"] - s["mu_top"], mean([lub[k] for k in band]) if lub else None,
-            wall_slip)
+    wall_slip = 0.5 * (weighted_slip(under, -1.0) + weighted_slip(over, 1.0))
+    return PointStress(J, s["mu"], mean([sxy[k] for k in band]), walls_plus_drag,
+                       s.get("dimension", 2), below, s["mu_bottom"] - s["mu_top"],
+                       mean([lub[k] for k in band]) if lub else None, next_to_walls, wall_slip)
 
 
 def wall_spacing(summary):
@@ -138,7 +162,7 @@ def print_split(by_j):
     beside the term of Boyer et al.'s fit that stands for it. For orientation only: their split is
     a fitting form, and their hydrodynamic term holds all the fluid's stress between particles
     (the one-body stresslet and the many-body far field too), of which lubrication is a part."""
-    rows = {J: [x for _, x in pts if x[7] is not None] for J, pts in by_j.items()}
+    rows = {J: [x for _, x in pts if x.lubrication is not None] for J, pts in by_j.items()}
     rows = {J: r for J, r in rows.items() if r}
     if not rows:
         return
@@ -148,7 +172,8 @@ def print_split(by_j):
     print("|---|---|---|---|---|---|---|---|")
     for J in sorted(rows):
         (con, con_e), (lub, lub_e) = (rundir.mean_sem(c) for c in
-                                      ([x[2] - x[7] for x in rows[J]], [x[7] for x in rows[J]]))
+                                      ([x.bulk - x.lubrication for x in rows[J]],
+                                       [x.lubrication for x in rows[J]]))
         bc, bh = boyer_contact_term(J), boyer_hydrodynamic_term(J)
         print(f"| {J:g} | {len(rows[J])} | {pm(con, con_e)} | {bc:.3g} | {con / bc:.3f} | "
               f"{pm(lub, lub_e)} | {bh:.3g} | {lub / bh:.3f} |")
@@ -172,37 +197,39 @@ def main():
             x = point_stresses(run)
             if x is None:
                 continue
-            by_j.setdefault(x[0], []).append((run.path, x))
+            by_j.setdefault(x.J, []).append((run.path, x))
     if not by_j:
         sys.exit("no stationary finished point with profiles in " + ", ".join(map(str, args.stores)))
-    dims = {x[4] for rows in by_j.values() for _, x in rows}
+    dims = {x.dimension for rows in by_j.values() for _, x in rows}
     if len(dims) > 1:
         sys.exit("the stores mix discs and spheres: tabulate each on its own")
     spheres = dims == {3}
     if args.points:
         # The drag over the whole gap is the walls' difference (x momentum of the whole cell):
         # the check that the profiles hold the drag.
-        print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk | drag over the "
-              "gap / P | mu_bottom - mu_top | lubrication part of the bulk's / P | slip at the walls / "
-              "(gammadot d) |" + (" walls' spacing / d |" if spheres else ""))
-        print("|---|---|---|---|---|---|---|---|---|" + ("---|" if spheres else ""))
+        print("| point | J | mu (walls) | bulk sigma_xy / P | mu + drag to the bulk | of which next "
+              "to the walls | drag over the gap / P | mu_bottom - mu_top | lubrication part of the "
+              "bulk's / P | slip at the walls / (gammadot d) |"
+              + (" walls' spacing / d |" if spheres else ""))
+        print("|---|---|---|---|---|---|---|---|---|---|" + ("---|" if spheres else ""))
         for J in sorted(by_j):
-            for path, (_, mu, bulk, plus, _, gap, diff, lub, slip) in by_j[J]:
+            for path, x in by_j[J]:
                 summary = rundir.Run(path).summary
                 flag = "" if summary.get("stationary") else " (not stationary)"
-                print(f"| {path.parent.parent.name}/{path.name}{flag} | {J:g} | {mu:.3f} | {bulk:.3f} | "
-                      f"{plus:.3f} | {gap:+.3f} | {diff:+.3f} | {fmt(lub)} | {slip:+.3f} |"
-                      + (f" {wall_spacing(summary):.3f} |" if spheres else ""))
+                print(f"| {path.parent.parent.name}/{path.name}{flag} | {J:g} | {x.mu:.3f} | "
+                      f"{x.bulk:.3f} | {x.walls_plus_drag:.3f} | {x.next_to_walls:+.3f} | "
+                      f"{x.gap_drag:+.3f} | {x.walls_difference:+.3f} | {fmt(x.lubrication)} | "
+                      f"{x.wall_slip:+.3f} |" + (f" {wall_spacing(summary):.3f} |" if spheres else ""))
         print()
     boyer = " Boyer | Boyer less J | bulk / Boyer | bulk / (Boyer less J) |" if spheres else ""
     print("| J | points | mu (walls) | bulk sigma_xy / P (pair forces) | mu + drag to the bulk | "
           "lubrication part of the bulk's (points) |" + boyer)
     print("|---|---|---|---|---|---|" + "---|" * (4 if spheres else 0))
     for J in sorted(by_j):
-        cols = list(zip(*[x[1:4] for _, x in by_j[J]]))
+        cols = list(zip(*[(x.mu, x.bulk, x.walls_plus_drag) for _, x in by_j[J]]))
         (mu, mu_e), (bulk, bulk_e), (plus, plus_e) = (rundir.mean_sem(c) for c in cols)
         # Points run before the lubrication part was measured have none: the mean of those that do.
-        lubs = [x[7] for _, x in by_j[J] if x[7] is not None]
+        lubs = [x.lubrication for _, x in by_j[J] if x.lubrication is not None]
         lub = pm(*rundir.mean_sem(lubs)) + f" ({len(lubs)})" if lubs else "-"
         row = (f"| {J:g} | {len(by_j[J])} | {pm(mu, mu_e)} | {pm(bulk, bulk_e)} | {pm(plus, plus_e)} "
                f"| {lub} |")

@@ -12,9 +12,9 @@ namespace sheardiff {
 
 namespace {
 
-// One rough wall: spheres of diameter 1 on a square lattice filling lx x lz (squeezed a little
-// where lx is not a whole number of diameters), centres at base + side (a + jitter a u), u in
-// [0, 1).
+// One rough wall: floor(lx) spheres of diameter 1 a side on a square lattice filling lx x lz
+// (gaps of up to 1/floor(lx) between them where lx is not a whole number of diameters: they
+// follow the cell's width), centres at base + side (a + jitter a u), u in [0, 1).
 void add_wall(Particles3& p, std::vector<int>& ids, double l, double base, int side, double jitter,
               Motion motion, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> uni(0.0, 1.0);
