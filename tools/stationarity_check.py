@@ -14,12 +14,15 @@
       signals as the run's own test, so that the strain at which a start reaches steady state
       can be read off.
 
-  stationarity_check.py blocks RUN_DIR...
+  stationarity_check.py blocks RUN_DIR... [--sliding N [--z Z]]
       A finished run's measured window block by block, from its summary.json alone (no
       trajectory): the block means its error bars and its verdict were formed from
       (`window_blocks`), and the least-squares lines through H's (the run's H_change) and phi's
       block means, each as its change over the window +- its standard error. Runs finished
-      before sheardiff wrote `window_blocks` are named as such.
+      before sheardiff wrote `window_blocks` are named as such. --sliding N adds the line
+      through H's block means over every N consecutive blocks (a shorter window's H_change
+      within a long one: N = 6 is a 20-strain window of 3-strain blocks), each with its z, and
+      how many lie beyond Z (3, the run's own test) standard errors.
 """
 import argparse
 import math
@@ -113,9 +116,28 @@ def window_line(t, y, span=None):
     return slope * span, err * span
 
 
-def blocks(paths):
+def sliding_lines(t, h, n, z):
+    """The line through H's block means h (midpoints t) over every n consecutive blocks, as
+    printed lines, and how many of them lie beyond z standard errors. A window holding an empty
+    block (null) is skipped."""
+    spacing = t[1] - t[0]
+    out, beyond, judged = [], 0, 0
+    for i in range(len(t) - n + 1):
+        if any(x is None for x in h[i:i + n]):
+            continue
+        change, err = window_line(t[i:i + n], h[i:i + n])
+        judged += 1
+        beyond += abs(change) > z * err
+        out.append(f"  strains {t[i] - spacing / 2:6.1f} - {t[i + n - 1] + spacing / 2:6.1f}: "
+                   f"{change:+.3f} +- {err:.3f} d (z {fmt_num(change / err if err > 0 else math.nan, '+.1f')})")
+    out.append(f"  {beyond} of {judged} beyond {z:g} standard errors")
+    return out
+
+
+def blocks(paths, sliding=None, z=3.0):
     """Each run's window_blocks as a table, and the lines through H's and phi's block means (the
-    first is the run's H_change)."""
+    first is the run's H_change); with sliding, the lines through every `sliding` consecutive
+    blocks of H too."""
     for path in map(pathlib.Path, paths):
         run = rundir.Run(path)
         if not run.finished:
@@ -143,6 +165,9 @@ def blocks(paths):
                 change, err = window_line(b["strain"], b[name])
                 print(f"line through {name}'s block means: {fmt_num(change, '+.4f')} +- "
                       f"{fmt_num(err, '.4f')}{unit} over the window")
+        if sliding and b.get("H") is not None and len(b["strain"]) >= sliding:
+            print(f"lines through H's block means over every {sliding} consecutive blocks:")
+            print("\n".join(sliding_lines(b["strain"], b["H"], sliding, z)))
         print()
 
 
@@ -208,6 +233,8 @@ def main():
     s.add_argument("--markdown", action="store_true")
     b = sub.add_parser("blocks")
     b.add_argument("runs", nargs="+")
+    b.add_argument("--sliding", type=int, default=None)
+    b.add_argument("--z", type=float, default=3.0)
     a = sub.add_parser("approach")
     a.add_argument("run")
     a.add_argument("--window", type=float, default=10.0)
@@ -222,7 +249,11 @@ def main():
             for path in args.results:
                 store(path)
     elif args.what == "blocks":
-        blocks(args.runs)
+        if args.sliding is not None and args.sliding < 3:
+            sys.exit("stationarity_check.py blocks: --sliding must be >= 3 (a line and its error)")
+        if not args.z > 0:
+            sys.exit("stationarity_check.py blocks: --z must be > 0")
+        blocks(args.runs, args.sliding, args.z)
     else:
         if not (args.window > 0 and args.block > 0 and args.z > 0 and args.tolerance > 0):
             sys.exit("stationarity_check.py: --window, --block, --z and --tolerance must be > 0")

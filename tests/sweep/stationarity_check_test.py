@@ -68,3 +68,27 @@ assert f"{unfinished}: no summary.json" in out, out
 assert f"{noverdict}: 4 blocks, verdict no verdict" in out and "H_change - +- - d" in out, out
 assert "   3.00 | 20.0000 | - | - | - | - | -" in out, out
 print("stationarity_check: blocks prints the window block by block and its line")
+
+# blocks --sliding 3: the line through every 3 consecutive blocks of H (2-strain blocks, so a
+# 6-strain span each). H flat, then rising 0.3 d a block, the last 0.01 d above the line:
+#   blocks 1-3 flat: change 0, no scatter, not beyond;
+#   blocks 2-4 (20, 20, 20.3): slope 0.6 / 8 a strain, change 0.45; residuals (0.05, -0.1, 0.05),
+#     so the slope's error sqrt(0.015 / 8) and the change's 6 times it, 0.260 (z 1.7);
+#   blocks 3-5 on a line: beyond; blocks 4-6 (20.3, 20.6, 20.91): change 0.915 +- 0.00866.
+wander = work / "wander"
+wander.mkdir(parents=True, exist_ok=True)
+(wander / "summary.json").write_text(json.dumps(dict(signals, stationary=True, window_blocks={
+    "strain": [1.0, 3.0, 5.0, 7.0, 9.0, 11.0], "H": [20.0, 20.0, 20.0, 20.3, 20.6, 20.91],
+    "phi": None, "mu": None, "mu_top_minus_bottom": None, "net_drag_y": None,
+    "bulk_normal_load": None})))
+out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
+                      str(wander), "--sliding", "3"], capture_output=True, text=True,
+                     check=True).stdout
+assert "lines through H's block means over every 3 consecutive blocks:" in out, out
+assert "  strains    2.0 -    8.0: +0.450 +- 0.260 d (z +1.7)" in out, out
+assert "  strains    6.0 -   12.0: +0.915 +- 0.009 d (z +105.7)" in out, out
+assert "  2 of 4 beyond 3 standard errors" in out, out
+bad = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
+                      str(wander), "--sliding", "2"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--sliding must be >= 3" in bad.stderr, bad.stderr
+print("stationarity_check: blocks --sliding prints each shorter window's line and counts them")
