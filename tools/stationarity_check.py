@@ -14,7 +14,7 @@
       signals as the run's own test, so that the strain at which a start reaches steady state
       can be read off.
 
-  stationarity_check.py blocks RUN_DIR... [--sliding N [--z Z]]
+  stationarity_check.py blocks RUN_DIR... [--sliding N [--z Z]] [--blocking]
       A finished run's measured window block by block, from its summary.json alone (no
       trajectory): the block means its error bars and its verdict were formed from
       (`window_blocks`), and the least-squares lines through H's (the run's H_change) and phi's
@@ -22,7 +22,11 @@
       before sheardiff wrote `window_blocks` are named as such. --sliding N adds the line
       through H's block means over every N consecutive blocks (a shorter window's H_change
       within a long one: N = 6 is a 20-strain window of 3-strain blocks), each with its z, and
-      how many lie beyond Z (3, the run's own test) standard errors.
+      how many lie beyond Z (3, the run's own test) standard errors. --blocking adds, per
+      signal, the lag-1 autocorrelation of the block means and the standard error of their mean
+      from blocks merged in pairs and in fours over that from single blocks: ratios above 1
+      mean the blocks are not independent and the run's error bars are that much too small
+      (merged blocks are counted from the window's start; a leftover block is dropped).
 """
 import argparse
 import math
@@ -134,7 +138,27 @@ def sliding_lines(t, h, n, z):
     return out
 
 
-def blocks(paths, sliding=None, z=3.0):
+def blocking(x):
+    """(lag-1 autocorrelation, sem from pairs / sem, sem from fours / sem) of block means x; NaN
+    where too few blocks (fewer than 3 merged means) or a null block."""
+    if any(v is None for v in x):
+        return math.nan, math.nan, math.nan
+    x = np.asarray(x, float)
+    d = x - x.mean()
+    lag1 = (d[1:] @ d[:-1]) / (d @ d) if d @ d > 0 else math.nan
+
+    def sem(v):
+        return v.std(ddof=1) / math.sqrt(len(v))
+
+    def ratio(m):
+        k = len(x) // m
+        return sem(x[:k * m].reshape(k, m).mean(axis=1)) / sem(x) if k >= 3 and sem(x) > 0 \
+            else math.nan
+
+    return lag1, ratio(2), ratio(4)
+
+
+def blocks(paths, sliding=None, z=3.0, show_blocking=False):
     """Each run's window_blocks as a table, and the lines through H's and phi's block means (the
     first is the run's H_change); with sliding, the lines through every `sliding` consecutive
     blocks of H too."""
@@ -168,6 +192,12 @@ def blocks(paths, sliding=None, z=3.0):
         if sliding and b.get("H") is not None and len(b["strain"]) >= sliding:
             print(f"lines through H's block means over every {sliding} consecutive blocks:")
             print("\n".join(sliding_lines(b["strain"], b["H"], sliding, z)))
+        if show_blocking:
+            print("signal | lag-1 autocorrelation | sem from pairs / sem | sem from fours / sem")
+            for c in BLOCK_COLUMNS:
+                if b.get(c) is not None:
+                    print(f"{c} | " + " | ".join(fmt_num(v, "+.2f" if i == 0 else ".2f")
+                                                 for i, v in enumerate(blocking(b[c]))))
         print()
 
 
@@ -235,6 +265,7 @@ def main():
     b.add_argument("runs", nargs="+")
     b.add_argument("--sliding", type=int, default=None)
     b.add_argument("--z", type=float, default=3.0)
+    b.add_argument("--blocking", action="store_true")
     a = sub.add_parser("approach")
     a.add_argument("run")
     a.add_argument("--window", type=float, default=10.0)
@@ -253,7 +284,7 @@ def main():
             sys.exit("stationarity_check.py blocks: --sliding must be >= 3 (a line and its error)")
         if not args.z > 0:
             sys.exit("stationarity_check.py blocks: --z must be > 0")
-        blocks(args.runs, args.sliding, args.z)
+        blocks(args.runs, args.sliding, args.z, args.blocking)
     else:
         if not (args.window > 0 and args.block > 0 and args.z > 0 and args.tolerance > 0):
             sys.exit("stationarity_check.py: --window, --block, --z and --tolerance must be > 0")

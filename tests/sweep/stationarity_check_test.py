@@ -92,3 +92,20 @@ bad = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"),
                       str(wander), "--sliding", "2"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--sliding must be >= 3" in bad.stderr, bad.stderr
 print("stationarity_check: blocks --sliding prints each shorter window's line and counts them")
+
+# blocks --blocking: mu's 12 block means alternate in pairs (1, 1, -1, -1, ...). Their lag-1
+# autocorrelation is 1/12 (eleven products +-1 summing to 1, over 12); the sem of single blocks
+# is sqrt(12/11)/sqrt(12), of pairs (1, -1, ...) sqrt(6/5)/sqrt(6), a ratio of 1.48; the fours'
+# means are all 0, a ratio of 0. A signal with a null block reads "-".
+paired = work / "paired"
+paired.mkdir(parents=True, exist_ok=True)
+(paired / "summary.json").write_text(json.dumps(dict(signals, stationary=True, window_blocks={
+    "strain": [1.0 + 2 * k for k in range(12)], "H": [20.0] * 11 + [None], "phi": None,
+    "mu": [1.0, 1.0, -1.0, -1.0] * 3, "mu_top_minus_bottom": None, "net_drag_y": None,
+    "bulk_normal_load": None})))
+out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
+                      str(paired), "--blocking"], capture_output=True, text=True,
+                     check=True).stdout
+assert "mu | +0.08 | 1.48 | 0.00" in out, out
+assert "H | - | - | -" in out, out
+print("stationarity_check: blocks --blocking reads the blocks' correlation")
