@@ -147,13 +147,13 @@ def blocking(x):
     d = x - x.mean()
     lag1 = (d[1:] @ d[:-1]) / (d @ d) if d @ d > 0 else math.nan
 
-    def sem(v):
-        return v.std(ddof=1) / math.sqrt(len(v))
+    single = rundir.mean_sem(x.tolist())[1]
 
     def ratio(m):
         k = len(x) // m
-        return sem(x[:k * m].reshape(k, m).mean(axis=1)) / sem(x) if k >= 3 and sem(x) > 0 \
-            else math.nan
+        if k < 3 or not single:
+            return math.nan
+        return rundir.mean_sem(x[:k * m].reshape(k, m).mean(axis=1).tolist())[1] / single
 
     return lag1, ratio(2), ratio(4)
 
