@@ -17,6 +17,16 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --boyer DIR    # only every J against Boyer et al.
     /usr/bin/python3 tools/results_table.py --discs DISC_DIR DIR   # spheres' D, dv, Psi, mu
                                                                    # against the discs'
+    /usr/bin/python3 tools/results_table.py --error-check DIR      # the runs' own error bars
+                                                                   # against the seeds' scatter
+
+--error-check asks whether one run's error bars (from its time blocks) hold the scatter between
+seeds. Per quantity and J (the stationary windows the fits used, two seeds or more): chi2 =
+sum_i (x_i - xbar)^2 / sigma_i^2 about the inverse-variance mean, with n - 1 degrees of freedom;
+then pooled over the J. R = sqrt(chi2 / dof) is the factor by which the seeds scatter more than
+the runs' error bars say (1 if the bars are right; above 1, a single run's bars are too small
+by about R), with its 68 % interval from the chi2 distribution and the chance of a chi2 at least
+as large if the bars were right.
 
 A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
 Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
@@ -32,6 +42,7 @@ run's own error bar, the ratio to the reference and the difference in combined s
 """
 import math
 import pathlib
+import re
 import sys
 
 import rundir
@@ -113,6 +124,14 @@ def main():
         if len(sys.argv) != 4:
             sys.exit(f"usage: {sys.argv[0]} --discs DISC_DIR DIR (two fit or sweep folders)")
         against_discs(one_group_rows(sys.argv[2]), one_group_rows(sys.argv[3]))
+        return
+    if len(sys.argv) >= 2 and sys.argv[1] == "--error-check":
+        if len(sys.argv) != 3:
+            sys.exit(f"usage: {sys.argv[0]} --error-check DIR (a fit or sweep folder)")
+        store = rundir.Store(pathlib.Path(sys.argv[2]))
+        if not store.has_table():
+            sys.exit(f"{sys.argv[2]}: no fits.json / sweep.csv")
+        error_check(store.fitted_rows())
         return
     modes = ("--laws", "--every-j", "--means", "--boyer")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
@@ -454,6 +473,56 @@ def runs_by_j(done):
     for r in done:
         by_j.setdefault(cell(r, "J"), []).append(r)
     return by_j
+
+
+ERROR_CHECKED = (("phi", "phi"), ("mu", "mu"), ("D", "D / (gammadot d^2)"),
+                 ("dv", "dv / (gammadot d)"), ("psi", "Psi gammadot"))
+
+
+def seeds_chi2(xs, errs):
+    """(chi2, degrees of freedom) of values xs with error bars errs about their inverse-variance
+    mean; (0, 0) below two values."""
+    w = [1.0 / e ** 2 for e in errs]
+    mean = sum(wi * x for wi, x in zip(w, xs)) / sum(w)
+    return sum(wi * (x - mean) ** 2 for wi, x in zip(w, xs)), len(xs) - 1
+
+
+def error_check(done):
+    """Per quantity: R = sqrt(chi2 / dof) of the seeds about their mean in the runs' own error
+    bars, at each J and pooled over J (see the module's docstring)."""
+    from scipy import stats
+
+    groups = {}
+    for r in done:
+        # One group per point name less its seed and its store (the other axes stay apart).
+        name = re.sub(r"(^|_)seed=[^_/]*", "", r["point"].rsplit("/", 1)[-1]) or "-"
+        groups.setdefault((cell(r, "J"), name), []).append(r)
+    keys = sorted((k for k, rs in groups.items() if len(rs) >= 2),
+                  key=lambda k: (k[0] is None, k[0] or 0.0, k[1]))
+    if not keys:
+        sys.exit("--error-check: no J with two or more stationary seeds")
+    heads = [f"J = {j:g}" + (f" ({n})" if not n.startswith("J=") and n != "-" else "")
+             + f", {len(groups[(j, n)])} seeds" for j, n in keys]
+    print("| quantity | " + " | ".join(heads) + " | pooled R [68 % interval] | dof | "
+          "P(chi2 >= measured) |")
+    print("|---|" + "---|" * len(keys) + "---|---|---|")
+    for q, label in ERROR_CHECKED:
+        chi2, dof, cells = 0.0, 0, []
+        for k in keys:
+            pairs = [(cell(r, q), cell(r, q + "_err")) for r in groups[k]]
+            pairs = [(x, e) for x, e in pairs if x is not None and e]
+            if len(pairs) < 2:
+                cells.append("-")
+                continue
+            c, n = seeds_chi2(*zip(*pairs))
+            chi2, dof = chi2 + c, dof + n
+            cells.append(f"{math.sqrt(c / n):.2f}")
+        if not dof:
+            continue
+        lo = math.sqrt(chi2 / stats.chi2.ppf(0.84, dof))
+        hi = math.sqrt(chi2 / stats.chi2.ppf(0.16, dof))
+        print(f"| {label} | " + " | ".join(cells) + f" | {math.sqrt(chi2 / dof):.2f} "
+              f"[{lo:.2f}, {hi:.2f}] | {dof} | {stats.chi2.sf(chi2, dof):.2g} |")
 
 
 def cost(done):

@@ -98,4 +98,31 @@ assert rows["0.02"][4] == "0.500 +- 0.006", rows["0.02"]
 assert rows["0.02"][-1] == "between J = 0.01 and 0.04", rows["0.02"]
 assert rows["0.04"][4].startswith("1.000 +- ") and rows["0.04"][-1] == "measured", rows["0.04"]
 assert rows["0.02"][6] == "-", rows["0.02"]  # no dv in either store
-print("results_table: per-J ratios, cost table, refusal, --compare and --discs as expected")
+# --error-check: at J = 0.01 three seeds of phi 0.80, 0.81, 0.82, each +- 0.005 (chi2 = 8, two
+# degrees of freedom: R = 2.00); at J = 0.02 two seeds of phi 0 and 1 with errors 1 and 2, whose
+# chi2 about the inverse-variance mean is 1 / (1 + 4) = 0.2 (an unweighted mean would give
+# 0.3125); a flagged window at J = 0.02 that would blow the chi2 up is left out. Pooled: chi2
+# 8.2 over 3 degrees of freedom, R = sqrt(8.2 / 3) = 1.65, P(chi2 >= 8.2 | 3) = 0.042.
+check = work / "error_check"
+check.mkdir(exist_ok=True)
+(check / "fits.json").write_text(json.dumps({"points": 6, "finished": 6, "groups": []}))
+with open(check / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=["point", "status", "J", "phi", "phi_err"])
+    w.writeheader()
+    for s_, x in enumerate((0.80, 0.81, 0.82), 1):
+        w.writerow({"point": f"a/J=0.01_seed={s_}", "status": "done", "J": 0.01, "phi": x,
+                    "phi_err": 0.005})
+    for s_, (x, e) in enumerate(((0.0, 1.0), (1.0, 2.0)), 1):
+        w.writerow({"point": f"b/J=0.02_seed={s_}", "status": "done", "J": 0.02, "phi": x,
+                    "phi_err": e})
+    w.writerow({"point": "b/J=0.02_seed=3", "status": "done, not stationary", "J": 0.02,
+                "phi": 50.0, "phi_err": 0.001})
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--error-check",
+                      str(check)], capture_output=True, text=True, check=True).stdout
+phi = next(l for l in out.splitlines() if l.startswith("| phi |"))
+cells = [c.strip() for c in phi.strip("|").split("|")]
+assert cells[1:3] == ["2.00", "0.45"], phi  # sqrt(8 / 2), sqrt(0.2 / 1)
+assert cells[3].startswith("1.65 [") and cells[4] == "3" and cells[5] == "0.042", phi
+assert "J = 0.02, 2 seeds" in out and "mu |" not in out, out
+print("results_table: per-J ratios, cost table, refusal, --compare, --discs and --error-check "
+      "as expected")
