@@ -17,8 +17,8 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --boyer DIR    # only every J against Boyer et al.
     /usr/bin/python3 tools/results_table.py --discs DISC_DIR DIR   # spheres' D, dv, Psi, mu
                                                                    # against the discs'
-    /usr/bin/python3 tools/results_table.py --error-check DIR      # the runs' own error bars
-                                                                   # against the seeds' scatter
+    /usr/bin/python3 tools/results_table.py --error-check DIR [J_MIN J_MAX]  # the runs' own
+                                                   # error bars against the seeds' scatter
 
 --error-check asks whether one run's error bars (from its time blocks) hold the scatter between
 seeds. Per quantity and J (the stationary windows the fits used, two seeds or more): chi2 =
@@ -126,12 +126,21 @@ def main():
         against_discs(one_group_rows(sys.argv[2]), one_group_rows(sys.argv[3]))
         return
     if len(sys.argv) >= 2 and sys.argv[1] == "--error-check":
-        if len(sys.argv) != 3:
-            sys.exit(f"usage: {sys.argv[0]} --error-check DIR (a fit or sweep folder)")
+        if len(sys.argv) not in (3, 5):
+            sys.exit(f"usage: {sys.argv[0]} --error-check DIR [J_MIN J_MAX] (a fit or sweep "
+                     f"folder; only the J within [J_MIN, J_MAX] if given)")
         store = rundir.Store(pathlib.Path(sys.argv[2]))
         if not store.has_table():
             sys.exit(f"{sys.argv[2]}: no fits.json / sweep.csv")
-        error_check(store.fitted_rows())
+        rows = store.fitted_rows()
+        if len(sys.argv) == 5:
+            try:
+                lo, hi = float(sys.argv[3]), float(sys.argv[4])
+            except ValueError:
+                sys.exit(f"--error-check: J_MIN and J_MAX must be numbers, not "
+                         f"{sys.argv[3]!r} {sys.argv[4]!r}")
+            rows = [r for r in rows if cell(r, "J") is not None and lo <= cell(r, "J") <= hi]
+        error_check(rows)
         return
     modes = ("--laws", "--every-j", "--means", "--boyer")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None

@@ -124,5 +124,11 @@ cells = [c.strip() for c in phi.strip("|").split("|")]
 assert cells[1:3] == ["2.00", "0.45"], phi  # sqrt(8 / 2), sqrt(0.2 / 1)
 assert cells[3].startswith("1.65 [") and cells[4] == "3" and cells[5] == "0.042", phi
 assert "J = 0.02, 2 seeds" in out and "mu |" not in out, out
+# Within a J range: J = 0.02 alone, chi2 0.2 over one degree of freedom.
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--error-check",
+                      str(check), "0.015", "0.1"], capture_output=True, text=True,
+                     check=True).stdout
+phi = next(l for l in out.splitlines() if l.startswith("| phi |"))
+assert "J = 0.01" not in out and phi.split("|")[3].strip().startswith("0.45 ["), out
 print("results_table: per-J ratios, cost table, refusal, --compare, --discs and --error-check "
       "as expected")
