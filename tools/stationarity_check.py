@@ -26,7 +26,10 @@
       signal, the lag-1 autocorrelation of the block means and the standard error of their mean
       from blocks merged in pairs and in fours over that from single blocks: ratios above 1
       mean the blocks are not independent and the run's error bars are that much too small
-      (merged blocks are counted from the window's start; a leftover block is dropped).
+      (merged blocks are counted from the window's start; a leftover block is dropped). With
+      several runs it ends with their lag-1 autocorrelations pooled per signal (mean +- its
+      standard error over the runs) beside what independent blocks give on average, -1/n for
+      n blocks (the estimator's own bias).
 """
 import argparse
 import math
@@ -161,7 +164,9 @@ def blocking(x):
 def blocks(paths, sliding=None, z=3.0, show_blocking=False):
     """Each run's window_blocks as a table, and the lines through H's and phi's block means (the
     first is the run's H_change); with sliding, the lines through every `sliding` consecutive
-    blocks of H too."""
+    blocks of H too; with show_blocking over several runs, their lag-1 autocorrelations
+    pooled."""
+    lag1s = {c: [] for c in BLOCK_COLUMNS}  # (lag-1, number of blocks) per signal
     for path in map(pathlib.Path, paths):
         run = rundir.Run(path)
         if not run.finished:
@@ -196,8 +201,21 @@ def blocks(paths, sliding=None, z=3.0, show_blocking=False):
             print("signal | lag-1 autocorrelation | sem from pairs / sem | sem from fours / sem")
             for c in BLOCK_COLUMNS:
                 if b.get(c) is not None:
+                    stats = blocking(b[c])
+                    if not math.isnan(stats[0]):
+                        lag1s[c].append((stats[0], len(b[c])))
                     print(f"{c} | " + " | ".join(fmt_num(v, "+.2f" if i == 0 else ".2f")
-                                                 for i, v in enumerate(blocking(b[c]))))
+                                                 for i, v in enumerate(stats)))
+        print()
+    runs = max(len(v) for v in lag1s.values())
+    if show_blocking and runs >= 2:
+        print(f"lag-1 autocorrelation pooled over the runs ({runs}):")
+        print("signal | runs | mean +- standard error | independent blocks: mean of -1/n")
+        for c in BLOCK_COLUMNS:
+            if len(lag1s[c]) >= 2:
+                m, e = rundir.mean_sem([r for r, _ in lag1s[c]])
+                expect = sum(-1.0 / n for _, n in lag1s[c]) / len(lag1s[c])
+                print(f"{c} | {len(lag1s[c])} | {m:+.2f} +- {e:.2f} | {expect:+.2f}")
         print()
 
 
