@@ -22,28 +22,21 @@ writes). Per group (ktilde, N, ...):
 
 --error-check asks whether one run's error bars (from its time blocks) hold the scatter between
 seeds. Per quantity and J (the stationary windows the fits used, two seeds or more): chi2 =
-sum_i (x_i - xbar)^2 / sigma_i^2 about the inverse-variance mean, with n - 1 degrees of freedom;
-then pooled over the J. R = sqrt(chi2 / dof) is the factor by which the seeds scatter more than
-the runs' error bars say (1 if the bars are right; above 1, a single run's bars are too small
-by about R), with its 68 % interval from the chi2 distribution and the chance of a chi2 at least
-as large if the bars were right.
-
-A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
-Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
-then the 2D reference for D, dv and Psi (the seed's phi law is a 2D one: not a reference).
-
-With --compare, single runs against a reference run (the checks of docs/results.md: one seed of
-another N, ktilde, mixing rule, ... against a point of the same seed): each quantity with the
-run's own error bar, the ratio to the reference and the difference in combined standard errors.
-
-    /usr/bin/python3 tools/results_table.py --compare REF_POINT POINT [POINT ...]
-
-(a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.01_N=500_seed=1)
+sum_i (x_i - xbar)^2 / sigma_i^2 about the inverse-variance mean, n - 1 degrees of freedom, then
+summed over the J. What right bars would give is drawn (40,000 draws, a fixed generator): values
+scattering as their bars say, and each bar itself an estimate from its run's `error_blocks`
+blocks (its variance scattering as chi2 with blocks - 1 degrees of freedom), which makes large
+chi2 likelier than the exact chi2 law says. R is the factor that puts the measured chi2 at the
+median of those draws (1 where the bars are right; above 1, a run's bars are too small by about
+R), with the 68 % interval from the draws' 16 and 84 % points and P, the share of draws at least
+as large as the measured chi2. Each J's cell is its own R.
 """
 import math
 import pathlib
 import re
 import sys
+
+import numpy as np
 
 import rundir
 
@@ -486,21 +479,33 @@ def runs_by_j(done):
 
 ERROR_CHECKED = (("phi", "phi"), ("mu", "mu"), ("D", "D / (gammadot d^2)"),
                  ("dv", "dv / (gammadot d)"), ("psi", "Psi gammadot"))
+ERROR_CHECK_DRAWS = 40000
 
 
 def seeds_chi2(xs, errs):
-    """(chi2, degrees of freedom) of values xs with error bars errs about their inverse-variance
-    mean; (0, 0) below two values."""
-    w = [1.0 / e ** 2 for e in errs]
-    mean = sum(wi * x for wi, x in zip(w, xs)) / sum(w)
-    return sum(wi * (x - mean) ** 2 for wi, x in zip(w, xs)), len(xs) - 1
+    """chi2 of values xs (last axis) with error bars errs about their inverse-variance mean."""
+    w = 1.0 / np.square(errs)
+    mean = (w * xs).sum(axis=-1, keepdims=True) / w.sum(axis=-1, keepdims=True)
+    return (w * np.square(xs - mean)).sum(axis=-1)
+
+
+def right_bars_chi2(errs, blocks, rng):
+    """ERROR_CHECK_DRAWS draws of seeds_chi2 for seeds whose bars are right: values drawn with the
+    bars errs, and each bar itself an estimate from its run's blocks (variance scattering as
+    chi2 with blocks - 1 degrees of freedom; exact where blocks is None)."""
+    errs = np.asarray(errs, float)
+    xs = rng.normal(size=(ERROR_CHECK_DRAWS, len(errs))) * errs
+    est = np.tile(errs, (ERROR_CHECK_DRAWS, 1))
+    for i, b in enumerate(blocks):
+        if b is not None and b > 1:
+            est[:, i] *= np.sqrt(rng.chisquare(b - 1, ERROR_CHECK_DRAWS) / (b - 1))
+    return seeds_chi2(xs, est)
 
 
 def error_check(done):
-    """Per quantity: R = sqrt(chi2 / dof) of the seeds about their mean in the runs' own error
-    bars, at each J and pooled over J (see the module's docstring)."""
-    from scipy import stats
-
+    """Per quantity: R, the factor by which the seeds scatter beyond their runs' own error bars,
+    at each J and pooled over J (see the module's docstring)."""
+    rng = np.random.default_rng(20261207)
     groups = {}
     for r in done:
         # One group per point name less its seed and its store (the other axes stay apart).
@@ -516,22 +521,26 @@ def error_check(done):
           "P(chi2 >= measured) |")
     print("|---|" + "---|" * len(keys) + "---|---|---|")
     for q, label in ERROR_CHECKED:
-        chi2, dof, cells = 0.0, 0, []
+        chi2, dof, null, cells = 0.0, 0, np.zeros(ERROR_CHECK_DRAWS), []
         for k in keys:
-            pairs = [(cell(r, q), cell(r, q + "_err")) for r in groups[k]]
-            pairs = [(x, e) for x, e in pairs if x is not None and e]
-            if len(pairs) < 2:
+            runs = [(cell(r, q), cell(r, q + "_err"), cell(r, "error_blocks"))
+                    for r in groups[k]]
+            runs = [t for t in runs if t[0] is not None and t[1]]
+            if len(runs) < 2:
                 cells.append("-")
                 continue
-            c, n = seeds_chi2(*zip(*pairs))
-            chi2, dof = chi2 + c, dof + n
-            cells.append(f"{math.sqrt(c / n):.2f}")
+            xs, errs, blocks = zip(*runs)
+            c = float(seeds_chi2(np.array(xs), np.array(errs)))
+            t = right_bars_chi2(errs, [None if b is None else int(b) for b in blocks], rng)
+            chi2, dof, null = chi2 + c, dof + len(runs) - 1, null + t
+            cells.append(f"{math.sqrt(c / np.median(t)):.2f}")
         if not dof:
             continue
-        lo = math.sqrt(chi2 / stats.chi2.ppf(0.84, dof))
-        hi = math.sqrt(chi2 / stats.chi2.ppf(0.16, dof))
-        print(f"| {label} | " + " | ".join(cells) + f" | {math.sqrt(chi2 / dof):.2f} "
-              f"[{lo:.2f}, {hi:.2f}] | {dof} | {stats.chi2.sf(chi2, dof):.2g} |")
+        lo, mid, hi = np.quantile(null, [0.84, 0.5, 0.16])
+        p = float(np.mean(null >= chi2))
+        p_cell = f"{p:.2g}" if p > 0 else f"< {1 / ERROR_CHECK_DRAWS:.1g}"
+        print(f"| {label} | " + " | ".join(cells) + f" | {math.sqrt(chi2 / mid):.2f} "
+              f"[{math.sqrt(chi2 / lo):.2f}, {math.sqrt(chi2 / hi):.2f}] | {dof} | {p_cell} |")
 
 
 def cost(done):

@@ -99,10 +99,24 @@ assert rows["0.02"][-1] == "between J = 0.01 and 0.04", rows["0.02"]
 assert rows["0.04"][4].startswith("1.000 +- ") and rows["0.04"][-1] == "measured", rows["0.04"]
 assert rows["0.02"][6] == "-", rows["0.02"]  # no dv in either store
 # --error-check: at J = 0.01 three seeds of phi 0.80, 0.81, 0.82, each +- 0.005 (chi2 = 8, two
-# degrees of freedom: R = 2.00); at J = 0.02 two seeds of phi 0 and 1 with errors 1 and 2, whose
-# chi2 about the inverse-variance mean is 1 / (1 + 4) = 0.2 (an unweighted mean would give
-# 0.3125); a flagged window at J = 0.02 that would blow the chi2 up is left out. Pooled: chi2
-# 8.2 over 3 degrees of freedom, R = sqrt(8.2 / 3) = 1.65, P(chi2 >= 8.2 | 3) = 0.042.
+# degrees of freedom); at J = 0.02 two seeds of phi 0 and 1 with errors 1 and 2, whose chi2 about
+# the inverse-variance mean is 1 / (1 + 4) = 0.2 (an unweighted mean would give 0.3125); a
+# flagged window at J = 0.02 that would blow the chi2 up is left out. Without error_blocks the
+# bars are exact, so right bars give chi2 with 2, 1 and (pooled) 3 degrees of freedom: R is
+# sqrt(chi2 / median), the interval from the 84 and 16 % points, P the tail beyond 8.2. The tool
+# draws these (40,000 draws), so its figures are held to the closed forms within 0.02-0.03.
+from scipy import stats
+
+
+def cells_of(text, name):
+    line = next(l for l in text.splitlines() if l.startswith(f"| {name} |"))
+    return [c.strip() for c in line.strip("|").split("|")]
+
+
+def near(cell, want, tol):
+    assert abs(float(cell) - want) <= tol, (cell, want)
+
+
 check = work / "error_check"
 check.mkdir(exist_ok=True)
 (check / "fits.json").write_text(json.dumps({"points": 6, "finished": 6, "groups": []}))
@@ -117,18 +131,34 @@ with open(check / "sweep.csv", "w", newline="") as f:
                     "phi_err": e})
     w.writerow({"point": "b/J=0.02_seed=3", "status": "done, not stationary", "J": 0.02,
                 "phi": 50.0, "phi_err": 0.001})
-out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--error-check",
-                      str(check)], capture_output=True, text=True, check=True).stdout
-phi = next(l for l in out.splitlines() if l.startswith("| phi |"))
-cells = [c.strip() for c in phi.strip("|").split("|")]
-assert cells[1:3] == ["2.00", "0.45"], phi  # sqrt(8 / 2), sqrt(0.2 / 1)
-assert cells[3].startswith("1.65 [") and cells[4] == "3" and cells[5] == "0.042", phi
-assert "J = 0.02, 2 seeds" in out and "mu |" not in out, out
-# Within a J range: J = 0.02 alone, chi2 0.2 over one degree of freedom.
-out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--error-check",
-                      str(check), "0.015", "0.1"], capture_output=True, text=True,
-                     check=True).stdout
-phi = next(l for l in out.splitlines() if l.startswith("| phi |"))
-assert "J = 0.01" not in out and phi.split("|")[3].strip().startswith("0.45 ["), out
+tool = [sys.executable, str(repo / "tools/results_table.py"), "--error-check", str(check)]
+out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
+cells = cells_of(out, "phi")
+near(cells[1], (8 / stats.chi2.median(2)) ** 0.5, 0.03)    # 2.40
+near(cells[2], (0.2 / stats.chi2.median(1)) ** 0.5, 0.02)  # 0.66
+pooled = cells[3].replace("[", "").replace("]", "").replace(",", "").split()
+near(pooled[0], (8.2 / stats.chi2.median(3)) ** 0.5, 0.02)      # 1.86
+near(pooled[1], (8.2 / stats.chi2.ppf(0.84, 3)) ** 0.5, 0.02)   # 1.26
+near(pooled[2], (8.2 / stats.chi2.ppf(0.16, 3)) ** 0.5, 0.03)   # 3.13
+assert cells[4] == "3", cells
+near(cells[5], stats.chi2.sf(8.2, 3), 0.004)                    # 0.042
+assert "J = 0.02, 2 seeds" in out and "| mu |" not in out, out
+# Within a J range: J = 0.02 alone.
+out = subprocess.run(tool + ["0.015", "0.1"], capture_output=True, text=True, check=True).stdout
+assert "J = 0.01" not in out and cells_of(out, "phi")[1] == cells[2], out
+# Bars estimated from 4 blocks each: two seeds of phi 0 and 1, +- 0.5. Their chi2 is
+# (x1 - x2)^2 / (s1^2 + s2^2) = 2, and with right bars it is Z^2 over (chi2 with 6 degrees of
+# freedom) / 6, an F(1, 6) variable: heavier-tailed than chi2 with one degree of freedom, so P
+# rises from 0.16 to 0.21 and R falls from 2.10 to 1.97.
+with open(check / "sweep.csv", "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=["point", "status", "J", "phi", "phi_err", "error_blocks"])
+    w.writeheader()
+    for s_, x in enumerate((0.0, 1.0), 1):
+        w.writerow({"point": f"J=0.01_seed={s_}", "status": "done", "J": 0.01, "phi": x,
+                    "phi_err": 0.5, "error_blocks": 4})
+out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
+cells = cells_of(out, "phi")
+near(cells[1], (2 / stats.f.median(1, 6)) ** 0.5, 0.03)
+near(cells[4], stats.f.sf(2, 1, 6), 0.01)
 print("results_table: per-J ratios, cost table, refusal, --compare, --discs and --error-check "
       "as expected")

@@ -108,18 +108,19 @@ out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"),
                      check=True).stdout
 assert "mu | +0.08 | 1.48 | 0.00" in out, out
 assert "H | - | - | -" in out, out
-# Pooled over two runs: a second run whose mu alternates block by block (1, -1, ...) has lag-1
-# -11/12; with the first's +1/12 the mean is -5/12 = -0.42 and its standard error over the two
-# 0.50; independent blocks of 12 would give -1/12 on average. H pools nothing: one run has it.
+# Pooled over two runs of different lengths: a second run of 4 blocks whose mu alternates (1, -1,
+# 1, -1) has lag-1 -3/4; with the first's +1/12 the mean is -1/3 = -0.33 and its standard error
+# over the two 0.42; independent blocks give -(1/12 + 1/4) / 2 = -0.17 on average (-1/n per run,
+# not -1 over the mean n, which would be -0.12). H pools nothing: one run has it.
 flip = work / "flip"
 flip.mkdir(parents=True, exist_ok=True)
 (flip / "summary.json").write_text(json.dumps(dict(signals, stationary=True, window_blocks={
-    "strain": [1.0 + 2 * k for k in range(12)], "H": None, "phi": None,
-    "mu": [1.0, -1.0] * 6, "mu_top_minus_bottom": None, "net_drag_y": None,
+    "strain": [1.0 + 2 * k for k in range(4)], "H": None, "phi": None,
+    "mu": [1.0, -1.0, 1.0, -1.0], "mu_top_minus_bottom": None, "net_drag_y": None,
     "bulk_normal_load": None})))
 out = subprocess.run([sys.executable, str(repo / "tools/stationarity_check.py"), "blocks",
                       str(paired), str(flip), "--blocking"], capture_output=True, text=True,
                      check=True).stdout
 pooled = out[out.index("lag-1 autocorrelation pooled over the runs (2):"):]
-assert "mu | 2 | -0.42 +- 0.50 | -0.08" in pooled and "\nH |" not in pooled, out
+assert "mu | 2 | -0.33 +- 0.42 | -0.17" in pooled and "\nH |" not in pooled, out
 print("stationarity_check: blocks --blocking reads the blocks' correlation, one run and pooled")
