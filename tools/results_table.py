@@ -15,6 +15,8 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --every-j DIR  # only every J against the seed's laws
     /usr/bin/python3 tools/results_table.py --means DIR    # only the means over seeds at every J
     /usr/bin/python3 tools/results_table.py --boyer DIR    # only every J against Boyer et al.
+    /usr/bin/python3 tools/results_table.py --ranges DIR   # only the exponents over parts of
+                                                           # the J range
     /usr/bin/python3 tools/results_table.py --discs DISC_DIR DIR   # spheres' D, dv, Psi, mu
                                                                    # against the discs'
     /usr/bin/python3 tools/results_table.py --error-check DIR [J_MIN J_MAX]  # the runs' own
@@ -135,7 +137,7 @@ def main():
             rows = [r for r in rows if cell(r, "J") is not None and lo <= cell(r, "J") <= hi]
         error_check(rows)
         return
-    modes = ("--laws", "--every-j", "--means", "--boyer")
+    modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
     if only:
         del sys.argv[1]
@@ -170,6 +172,8 @@ def main():
             against_seed_laws(g["rows"], False, dimension=dimension)
         elif only == "--means":
             means_table(g["rows"])
+        elif only == "--ranges":
+            subrange_fits(store.fitted_rows(), heading=False)
         else:
             against_boyer(g["rows"], False)
         return
@@ -391,13 +395,12 @@ def against_seed_laws(rows, heading=True, dimension=2):
     print()
 
 
-def subrange_fits(done, replicates=2000):
+def subrange_fits(done, replicates=2000, heading=True):
     """The exponents over parts of the J range: which J drive a fit. OLS in log-log space on the
     seeds' means (the seed's Appendix B) and phi = phi_c - a J^b by least squares (not the
     seed's alignment procedure: a check of where the curvature sits, not a Table 1 value);
     errors from a bootstrap over seeds, each J's runs widened about their mean by sqrt(n/(n-1))
     as in `sheardiff sweep --collect`."""
-    import numpy as np
     from scipy.optimize import curve_fit
 
     by_j = {}
@@ -438,7 +441,8 @@ def subrange_fits(done, replicates=2000):
         m = {q: np.mean([r[q] for r in runs]) for q in runs[0]}
         return [{q: m[q] + w * (r[q] - m[q]) for q in r} for r in runs]
 
-    print("#### Exponents over parts of the J range (seed-bootstrap errors)\n")
+    if heading:
+        print("#### Exponents over parts of the J range (seed-bootstrap errors)\n")
     print("| J range | J values | D: b | dv: b | Psi: b | phi = phi_c - a J^b (least squares) |")
     print("|---|---|---|---|---|---|")
     for lo, hi in ((js[0], js[-1]), (js[0], js[-2]), (js[1], js[-2]), (js[0], js[-3])):
@@ -459,7 +463,8 @@ def subrange_fits(done, replicates=2000):
               + " | ".join(pm(best[q], err[q]) for q in ("D", "dv", "psi"))
               + f" | phi_c = {pm(best['phi_c'], err['phi_c'], 4)}, a = {pm(best['a'], err['a'])}, "
               f"b = {pm(best['b'], err['b'])} |")
-    print()
+    if heading:
+        print()
 
 
 def cell(r, k):

@@ -52,6 +52,10 @@ full = next(l for l in ranges if l.startswith("| 0.0001 - 0.1 |"))
 cells = [c.strip() for c in full.strip("|").split("|")]
 assert cells[2].startswith("-0.26 ") and cells[3].startswith("-0.25 "), full
 assert cells[4].startswith("0.24 ") and "b = 0.5 " in cells[5], full
+# --ranges prints that table alone, the same rows without the heading.
+only = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--ranges",
+                       str(work)], capture_output=True, text=True, check=True).stdout
+assert only.splitlines()[0].startswith("| J range |") and full in only.splitlines(), only
 # A store of channel cases: no J fits, refused with the reason.
 fits = {"points": 2, "finished": 2, "groups": []}
 (work / "fits.json").write_text(json.dumps(fits))
