@@ -34,6 +34,11 @@ one store against another at the same J:
 An --only KEY that REF_DIR also has as an axis filters REF_DIR's points too (one ktilde of a
 sweep over several).
 
+With --widen Q=FACTOR the runs' own error bars of Q are multiplied by FACTOR before the larger of
+them and the scatter is taken: the factor by which the seeds scatter beyond one run's bars
+(`tools/results_table.py --error-check`), so that a comparison resting on one or two runs is not
+judged against bars the seeds' scatter shows too small.
+
 With --first-order (an axis of integrator.max_displacement), each other step h also estimates
 the reference step h0's own bias, if the error is first order in the step (q(h) = q(0) + c h,
 docs/performance.md "Matched trajectory error"): q(h0) - q(0) = (q(h) - q(h0)) h0 / (h - h0),
@@ -136,11 +141,26 @@ def main():
     ap.add_argument("--first-order", action="store_true",
                     help="with --axis integrator.max_displacement: the reference step's own bias "
                     "estimated from each other step, if the error is first order in the step")
+    ap.add_argument("--widen", action="append", default=[], metavar="Q=FACTOR",
+                    help="multiply the runs' own error bars of quantity Q (phi, mu, dv, psi, D, "
+                    "...) by FACTOR before they enter the standard error (repeatable): the R of "
+                    "`results_table.py --error-check`, where the seeds scatter beyond one run's "
+                    "bars")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
                     help="keep only the points whose axis KEY (or summary column KEY) has this "
                     "value (repeatable), e.g. one J of a sweep over several J against that J's "
                     "reference")
     a = ap.parse_args()
+    widen = {}
+    for w in a.widen:
+        q, eq, factor = w.partition("=")
+        try:
+            widen[q] = float(factor)
+        except ValueError:
+            widen[q] = math.nan
+        if not eq or not widen[q] >= 1.0 or not math.isfinite(widen[q]):
+            sys.exit(f"--widen {w}: give Q=FACTOR with a quantity Q and a FACTOR >= 1, e.g. "
+                     f"phi=1.57")
     rows, axes = finished_rows(a.dir)
     if a.stationary_only:
         rows = stationary(rows, a.dir)
@@ -201,6 +221,7 @@ def main():
         errs = [float(r[q + "_err"]) for r in rs if r.get(q + "_err") not in (None, "")]
         if m is not None and errs and len(errs) == len(rs):
             own = math.sqrt(sum(x * x for x in errs) / len(errs)) / math.sqrt(len(errs))
+            own *= widen.get(q, 1.0)
             e = own if e is None else max(e, own)
         return m, e
 
@@ -209,7 +230,9 @@ def main():
           f"Cells: mean over seeds +- standard error of the mean (the larger of the "
           f"seeds' scatter and the runs' own error bars); "
           f"(z, r) = difference from the reference in combined standard errors and in the "
-          f"reference's standard error.")
+          f"reference's standard error."
+          + "".join(f" The runs' own bars of {q} are widened {f:g} times." for q, f in
+                    widen.items()))
     flagged = sorted({r["point"] + " (" + r["status"] + ")"
                       for rs in groups.values() for r in rs if not rundir.is_stationary(r)})
     if a.reference_from:

@@ -95,6 +95,15 @@ out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
 line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[5].endswith("+- 0.5"), f"psi cell {cells[5]!r}: want the runs' own error 1/sqrt(4)"
+# --widen psi=1.5: those own bars count 1.5 times, 0.75 for the mean; a factor below 1 is refused.
+out = subprocess.run(tool + ["--widen", "psi=1.5"], capture_output=True, text=True,
+                     check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
+cells = [c.strip() for c in line.strip("|").split("|")]
+assert cells[5].endswith("+- 0.75"), f"psi cell {cells[5]!r}: want 1.5 / sqrt(4)"
+assert "The runs' own bars of psi are widened 1.5 times." in out, out
+bad = subprocess.run(tool + ["--widen", "psi=0.5"], capture_output=True, text=True)
+assert bad.returncode != 0 and "--widen psi=0.5" in bad.stderr, bad.stderr
 bad = subprocess.run(tool + ["--axis", "flow.J"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--axis" in bad.stderr, bad.stderr
 # The md = 3e-4 points as the reference of another sweep (a new setting, same seeds): its biased
