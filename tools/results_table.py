@@ -541,11 +541,12 @@ def error_check(done):
             cells.append(f"{math.sqrt(c / np.median(t)):.2f}")
         if not dof:
             continue
-        lo, mid, hi = np.quantile(null, [0.84, 0.5, 0.16])
+        # A larger chi2 of right bars needs a smaller R: the 84 % point bounds R from below.
+        q84, median, q16 = np.quantile(null, [0.84, 0.5, 0.16])
         p = float(np.mean(null >= chi2))
         p_cell = f"{p:.2g}" if p > 0 else f"< {1 / ERROR_CHECK_DRAWS:.1g}"
-        print(f"| {label} | " + " | ".join(cells) + f" | {math.sqrt(chi2 / mid):.2f} "
-              f"[{math.sqrt(chi2 / lo):.2f}, {math.sqrt(chi2 / hi):.2f}] | {dof} | {p_cell} |")
+        print(f"| {label} | " + " | ".join(cells) + f" | {math.sqrt(chi2 / median):.2f} "
+              f"[{math.sqrt(chi2 / q84):.2f}, {math.sqrt(chi2 / q16):.2f}] | {dof} | {p_cell} |")
 
 
 def cost(done):
