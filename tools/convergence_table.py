@@ -34,8 +34,9 @@ one store against another at the same J:
 An --only KEY that REF_DIR also has as an axis filters REF_DIR's points too (one ktilde of a
 sweep over several).
 
-With --widen Q=FACTOR the runs' own error bars of Q are multiplied by FACTOR before the larger of
-them and the scatter is taken: the factor by which the seeds scatter beyond one run's bars
+With --widen Q=FACTOR the runs' own error bars of Q are multiplied by FACTOR, in every group and in
+the reference (so the --first-order estimates move with them), before the larger of them and the
+scatter is taken: the factor by which the seeds scatter beyond one run's bars
 (`tools/results_table.py --error-check`), so that a comparison resting on one or two runs is not
 judged against bars the seeds' scatter shows too small.
 
@@ -142,10 +143,11 @@ def main():
                     help="with --axis integrator.max_displacement: the reference step's own bias "
                     "estimated from each other step, if the error is first order in the step")
     ap.add_argument("--widen", action="append", default=[], metavar="Q=FACTOR",
-                    help="multiply the runs' own error bars of quantity Q (phi, mu, dv, psi, D, "
-                    "...) by FACTOR before they enter the standard error (repeatable): the R of "
-                    "`results_table.py --error-check`, where the seeds scatter beyond one run's "
-                    "bars")
+                    help="multiply the runs' own error bars of quantity Q (a column of the "
+                    "table: phi, mu, dv, psi, D, ...) by FACTOR, in every group and the "
+                    "reference's, before the larger of them and the seeds' scatter is taken "
+                    "(repeatable): the R of `results_table.py --error-check`, where the seeds "
+                    "scatter beyond one run's bars")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
                     help="keep only the points whose axis KEY (or summary column KEY) has this "
                     "value (repeatable), e.g. one J of a sweep over several J against that J's "
@@ -158,9 +160,10 @@ def main():
             widen[q] = float(factor)
         except ValueError:
             widen[q] = math.nan
-        if not eq or not widen[q] >= 1.0 or not math.isfinite(widen[q]):
-            sys.exit(f"--widen {w}: give Q=FACTOR with a quantity Q and a FACTOR >= 1, e.g. "
-                     f"phi=1.57")
+        known = [k for k, _ in QUANTITIES + SIMPLE_SHEAR_QUANTITIES]
+        if not eq or q not in known or not widen[q] >= 1.0 or not math.isfinite(widen[q]):
+            sys.exit(f"--widen {w}: give Q=FACTOR with Q one of {sorted(set(known))} and a "
+                     f"FACTOR >= 1, e.g. phi=1.57")
     rows, axes = finished_rows(a.dir)
     if a.stationary_only:
         rows = stationary(rows, a.dir)

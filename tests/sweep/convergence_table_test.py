@@ -95,15 +95,24 @@ out = subprocess.run(tool, capture_output=True, text=True, check=True).stdout
 line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[5].endswith("+- 0.5"), f"psi cell {cells[5]!r}: want the runs' own error 1/sqrt(4)"
-# --widen psi=1.5: those own bars count 1.5 times, 0.75 for the mean; a factor below 1 is refused.
+# --widen psi=1.5: those own bars count 1.5 times, 0.75 for the mean, in the reference and in the
+# other groups alike; D has no own bars and keeps its scatter. --widen D=2 leaves psi's 0.5. A
+# factor below 1 and a name that is not a column are refused.
 out = subprocess.run(tool + ["--widen", "psi=1.5"], capture_output=True, text=True,
                      check=True).stdout
-line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
-cells = [c.strip() for c in line.strip("|").split("|")]
-assert cells[5].endswith("+- 0.75"), f"psi cell {cells[5]!r}: want 1.5 / sqrt(4)"
+for md in ("0.0003", "0.003"):
+    line = next(l for l in out.splitlines() if l.startswith(f"| {md} |"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    want = "+- 0.75" if md == "0.0003" else "+- 0.75 (+0.0, +0.0)"
+    assert cells[5].endswith(want), f"psi cell {cells[5]!r} at md = {md}: want 1.5 / sqrt(4)"
 assert "The runs' own bars of psi are widened 1.5 times." in out, out
-bad = subprocess.run(tool + ["--widen", "psi=0.5"], capture_output=True, text=True)
-assert bad.returncode != 0 and "--widen psi=0.5" in bad.stderr, bad.stderr
+out = subprocess.run(tool + ["--widen", "D=2"], capture_output=True, text=True,
+                     check=True).stdout
+line = next(l for l in out.splitlines() if l.startswith("| 0.0003 |"))
+assert [c.strip() for c in line.strip("|").split("|")][5].endswith("+- 0.5"), line
+for wrong in ("psi=0.5", "Psi=1.5"):
+    bad = subprocess.run(tool + ["--widen", wrong], capture_output=True, text=True)
+    assert bad.returncode != 0 and f"--widen {wrong}" in bad.stderr, bad.stderr
 bad = subprocess.run(tool + ["--axis", "flow.J"], capture_output=True, text=True)
 assert bad.returncode != 0 and "--axis" in bad.stderr, bad.stderr
 # The md = 3e-4 points as the reference of another sweep (a new setting, same seeds): its biased
