@@ -154,15 +154,15 @@ def main():
                     "reference")
     a = ap.parse_args()
     widen = {}
+    known = sorted({k for k, _ in QUANTITIES + SIMPLE_SHEAR_QUANTITIES})
     for w in a.widen:
         q, eq, factor = w.partition("=")
         try:
             widen[q] = float(factor)
         except ValueError:
             widen[q] = math.nan
-        known = [k for k, _ in QUANTITIES + SIMPLE_SHEAR_QUANTITIES]
         if not eq or q not in known or not widen[q] >= 1.0 or not math.isfinite(widen[q]):
-            sys.exit(f"--widen {w}: give Q=FACTOR with Q one of {sorted(set(known))} and a "
+            sys.exit(f"--widen {w}: give Q=FACTOR with Q one of {known} and a "
                      f"FACTOR >= 1, e.g. phi=1.57")
     rows, axes = finished_rows(a.dir)
     if a.stationary_only:

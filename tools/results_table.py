@@ -32,6 +32,18 @@ chi2 likelier than the exact chi2 law says. R is the factor that puts the measur
 median of those draws (1 where the bars are right; above 1, a run's bars are too small by about
 R), with the 68 % interval from the draws' 16 and 84 % points and P, the share of draws at least
 as large as the measured chi2. Each J's cell is its own R.
+
+A sweep of spheres (sweep.csv's dimension = 3) adds every J against the 3D experiments of Boyer,
+Guazzelli & Pouliquen (2011): phi and mu with their fits evaluated there. The seed's laws are
+then the 2D reference for D, dv and Psi (the seed's phi law is a 2D one: not a reference).
+
+With --compare, single runs against a reference run (the checks of docs/results.md: one seed of
+another N, ktilde, mixing rule, ... against a point of the same seed): each quantity with the
+run's own error bar, the ratio to the reference and the difference in combined standard errors.
+
+    /usr/bin/python3 tools/results_table.py --compare REF_POINT POINT [POINT ...]
+
+(a POINT is a folder holding a summary.json, e.g. results/size_check/points/J=0.01_N=500_seed=1)
 """
 import math
 import pathlib
@@ -134,7 +146,7 @@ def main():
             except ValueError:
                 sys.exit(f"--error-check: J_MIN and J_MAX must be numbers, not "
                          f"{sys.argv[3]!r} {sys.argv[4]!r}")
-            rows = [r for r in rows if cell(r, "J") is not None and lo <= cell(r, "J") <= hi]
+            rows = [r for r in rows if lo <= (cell(r, "J") or math.nan) <= hi]
         error_check(rows)
         return
     modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges")
