@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/interactions/fluid_layer.hpp"
 #include "sheardiff/interactions/stokes_drag.hpp"
 #include "sheardiff/io/hdf5_tables.hpp"
@@ -219,9 +220,7 @@ TEST(Channel, SummaryColumnsOneAndTwoWay) {
     c.output.frame_strain = 5.0;
     c.output.trajectory = false;
     c.run.strain = 20.0;
-    const auto dir = std::filesystem::temp_directory_path() /
-                     (std::string("sheardiff_test_channel_") + coupling);
-    std::filesystem::remove_all(dir);
+    const ScratchDir dir(coupling);
     const nlohmann::json js = run_to_directory(c, dir, false);
     // The history is in DIR/channel.h5 (rows every 5 a/<u>: the last interval closes at the
     // run's end, or is still open), not in the summary.
@@ -232,7 +231,6 @@ TEST(Channel, SummaryColumnsOneAndTwoWay) {
     EXPECT_NEAR(time.back(), js["strain"].get<double>(), 1e-9);
     const auto phi_rows = read_dataset(dir / "channel.h5", "/channel_history/phi");
     EXPECT_EQ(phi_rows.size(), time.size() * js["channel_y"].size());
-    std::filesystem::remove_all(dir);
     const bool two_way = std::string(coupling) == "two_way";
     EXPECT_EQ(js["channel_coupling"], coupling);
     if (!two_way) {

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/core/archive.hpp"
 #include "sheardiff/core/text.hpp"
 #include "sheardiff/io/checkpoint_file.hpp"
@@ -139,8 +140,7 @@ void expect_same_final_state(const fs::path& a, const fs::path& b, bool with_cou
 }
 
 TEST(Checkpoint, SigkillAtRandomMomentThenResumeIsBitIdentical) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_kill";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
 
@@ -162,12 +162,10 @@ TEST(Checkpoint, SigkillAtRandomMomentThenResumeIsBitIdentical) {
 
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "killed")), 0);
   expect_same_final_state(root / "whole", root / "killed");
-  fs::remove_all(root);
 }
 
 TEST(Checkpoint, SigtermWritesCheckpointAndExitsCleanly) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_term";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   const pid_t pid = spawn(cfg, root / "stopped");
@@ -181,12 +179,10 @@ TEST(Checkpoint, SigtermWritesCheckpointAndExitsCleanly) {
   ASSERT_TRUE(fs::exists(root / "stopped" / "checkpoint.bin"));
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
   expect_same_final_state(root / "whole", root / "stopped");
-  fs::remove_all(root);
 }
 
 TEST(Checkpoint, ResumeRefusesAnotherConfiguration) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_other";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   const pid_t pid = spawn(cfg, root / "run");
   for (int k = 0; k < 2000 && !fs::exists(root / "run" / "checkpoint.bin"); ++k)
@@ -195,7 +191,6 @@ TEST(Checkpoint, ResumeRefusesAnotherConfiguration) {
   wait_exit(pid);
   // Resuming with a different J is a configuration error (exit 2), not a silent mix.
   EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "run", {"--set", "flow.J=0.1"})), 2);
-  fs::remove_all(root);
 }
 
 std::vector<char> bytes_of(const fs::path& f) {
@@ -226,8 +221,7 @@ void make_interrupted_run(const fs::path& cfg, const fs::path& dir) {
 // bit, the run that was started with that strain: the end is only tested, never anticipated.
 // What it had written when it finished is kept in earlier/end_strain=S/.
 TEST(Checkpoint, ExtendedRunIsTheLongerRunToTheBit) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_extend";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "direct")), 0);
   ASSERT_EQ(
@@ -251,15 +245,13 @@ TEST(Checkpoint, ExtendedRunIsTheLongerRunToTheBit) {
   EXPECT_EQ(earlier, first);
   EXPECT_TRUE(fs::exists(kept[0] / "analysis.h5"));
   EXPECT_NE(text_of(kept[0] / "config.toml").find("strain = 1.2"), std::string::npos);
-  fs::remove_all(root);
 }
 
 // Only the end may change: another J is refused naming the key, a shorter end and an end the
 // run has passed are refused, a run finished without its final state cannot be extended; each
 // refusal (exit 2) leaves the directory as it was. An interrupted run may be given a further end.
 TEST(Checkpoint, ExtensionOnlyMovesTheEnd) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_extend_refused";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   const fs::path dir = root / "run", err = root / "err.txt";
   ASSERT_EQ(wait_exit(spawn(cfg, dir)), 0);
@@ -294,15 +286,13 @@ TEST(Checkpoint, ExtensionOnlyMovesTheEnd) {
   std::ifstream(root / "int" / "summary.json") >> js;
   EXPECT_NEAR(js["strain"].get<double>(), 2.5, 0.01);
   EXPECT_NE(text_of(root / "int" / "config.toml").find("strain = 2.5"), std::string::npos);
-  fs::remove_all(root);
 }
 
 // A finished run whose summary.json was deleted, or one whose checkpoint.bin was, looked like a
 // start killed before its first checkpoint: --resume deleted its analysis and rewrote its whole
 // trajectory from strain 0. It must be refused (exit 2) with every file left as it was.
 TEST(Checkpoint, ResumeNeverRestartsARunThatGotPastItsFirstCheckpoint) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_lost_summary";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   const fs::path dir = root / "run";
   ASSERT_EQ(wait_exit(spawn(cfg, dir)), 0);
@@ -325,14 +315,12 @@ TEST(Checkpoint, ResumeNeverRestartsARunThatGotPastItsFirstCheckpoint) {
   // A sweep asks the same question of a point directory before it starts one afresh.
   RunDirectory held(dir, false);
   EXPECT_NE(restart_would_lose(held, load_config(cfg)), "");
-  fs::remove_all(root);
 }
 
 // A resumed run whose config.toml had been deleted finished without it, and `analyse` then
 // failed: the resume writes it again from the checkpoint's (checked) configuration.
 TEST(Checkpoint, ResumeWritesADeletedConfigAgain) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_lost_config";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   const fs::path dir = root / "run";
   make_interrupted_run(cfg, dir);
@@ -343,15 +331,13 @@ TEST(Checkpoint, ResumeWritesADeletedConfigAgain) {
   EXPECT_NE(text_of(err).find("config.toml was missing"), std::string::npos) << text_of(err);
   EXPECT_TRUE(fs::exists(dir / "summary.json"));
   EXPECT_EQ(text_of(dir / "config.toml"), config);
-  fs::remove_all(root);
 }
 
 // Issue 35, case 11: a checkpoint.bin that is a directory gave "basic_filebuf::underflow error
 // ... Is a directory" naming no file; a run whose directory was renamed under it said "No
 // checkpoint was written yet" though one existed.
 TEST(Checkpoint, MessagesNameTheFileAndWhereTheRunWent) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_messages";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   const fs::path err = root / "err.txt";
   make_interrupted_run(cfg, root / "dir_checkpoint");
@@ -380,7 +366,6 @@ TEST(Checkpoint, MessagesNameTheFileAndWhereTheRunWent) {
   // And it continues where it is now.
   EXPECT_EQ(wait_exit(spawn_resume(cfg, moved, {}, err)), 0) << text_of(err);
   EXPECT_TRUE(fs::exists(moved / "summary.json"));
-  fs::remove_all(root);
 }
 
 // The trajectory's image counts, every frame.
@@ -400,8 +385,7 @@ std::vector<int> image_counts(const fs::path& traj) {
 // not in the positions), kept in the checkpoint: a simple-shear run stopped late and resumed
 // writes the images of the run never stopped.
 TEST(Checkpoint, ImageCountsSurviveAResume) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_images";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root, "simple_shear");
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
@@ -416,7 +400,6 @@ TEST(Checkpoint, ImageCountsSurviveAResume) {
   const auto a = image_counts(root / "whole" / "trajectory.h5");
   EXPECT_EQ(a, image_counts(root / "stopped" / "trajectory.h5"));
   EXPECT_NE(std::count(a.begin(), a.end(), 0), static_cast<long>(a.size())) << "no crossing";
-  fs::remove_all(root);
 }
 
 // Issue 35, case 3: channel runs resumed 1e-13 d off in the first frame after the checkpoint and
@@ -424,9 +407,7 @@ TEST(Checkpoint, ImageCountsSurviveAResume) {
 // checkpoint instead of those at the last neighbour rebuild, so CHOLMOD ordered another matrix.
 // Layout 5 keeps those heights: a channel run killed and resumed ends bit-identical.
 TEST(Checkpoint, ChannelResumeIsBitIdentical) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_channel_resume";
-  fs::remove_all(root);
-  fs::create_directories(root);
+  const ScratchDir root;
   const fs::path cfg = root / "channel.toml";
   // Case D of configs/channel (86 discs, H = 40.4 a), whose resumes differed from strain 20 on.
   std::ofstream(cfg) << R"([scene]
@@ -478,7 +459,6 @@ checkpoint_strain = 20.0
   for (const char* clock : {"wall_seconds", "ms_per_step", "started", "finished"})
     sa.erase(clock), sb.erase(clock);
   EXPECT_EQ(sa, sb);
-  fs::remove_all(root);
 }
 
 // Issue 16: a flipped mantissa byte resumed to exit 0 with other results, a flipped exponent
@@ -486,8 +466,7 @@ checkpoint_strain = 20.0
 // ended in std::bad_alloc without the file's name. Each must be named as corrupt (exit 2) and
 // the file left as it is.
 TEST(Checkpoint, CorruptCheckpointIsNamedNeverResumedNeverOverwritten) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_corrupt";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "run");
   const std::vector<char> pristine = bytes_of(root / "run" / "checkpoint.bin");
@@ -517,7 +496,6 @@ TEST(Checkpoint, CorruptCheckpointIsNamedNeverResumedNeverOverwritten) {
     EXPECT_FALSE(fs::exists(dir / "summary.json"));
     EXPECT_FALSE(fs::exists(dir / "diagnostic.txt"));
   }
-  fs::remove_all(root);
 }
 
 // A corrupt length field inside the state is bounded by what is left of the file.
@@ -543,8 +521,7 @@ TEST(Checkpoint, ArchiveLengthsAreBoundedByTheFile) {
 // without the diffusion analysis, whose state layout has not changed since (a pressure cell's
 // has, and so has the diffusion analysis's: the next tests).
 TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_v2";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root, "simple_shear", /*diffusion=*/false);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
@@ -570,15 +547,13 @@ TEST(Checkpoint, VersionTwoCheckpointStillResumes) {
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "old", {}, root / "err.txt")), 0);
   EXPECT_NE(text_of(root / "err.txt").find("has no checksum"), std::string::npos);
   expect_same_final_state(root / "whole", root / "old", /*with_counters=*/false);
-  fs::remove_all(root);
 }
 
 // A pressure-cell checkpoint of layout 3 (before the gap profiles became their own observer)
 // cannot be placed in today's state: refused before anything is read, with that reason and the
 // way out (the sheardiff that started it), exit 2, the file left as it was.
 TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_layout3";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
@@ -591,15 +566,13 @@ TEST(Checkpoint, OlderPressureCellLayoutIsRefusedWithItsReason) {
   EXPECT_NE(err.find("earlier sheardiff (checkpoint layout 3)"), std::string::npos) << err;
   EXPECT_NE(err.find("run.log"), std::string::npos) << err;
   EXPECT_EQ(bytes_of(root / "old" / "checkpoint.bin"), bytes);
-  fs::remove_all(root);
 }
 
 // A checkpoint of layout 5 kept the measured window's frames for the diffusion analysis; this
 // version accumulates it while running, so such a state cannot be continued: refused with that
 // reason and the way out, exit 2, the file left as it was.
 TEST(Checkpoint, FrameKeepingDiffusionLayoutIsRefusedWithItsReason) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_layout5";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root, "simple_shear");
   make_interrupted_run(cfg, root / "old");
   std::vector<char> bytes = bytes_of(root / "old" / "checkpoint.bin");
@@ -614,14 +587,12 @@ TEST(Checkpoint, FrameKeepingDiffusionLayoutIsRefusedWithItsReason) {
       << err;
   EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
   EXPECT_EQ(bytes_of(root / "old" / "checkpoint.bin"), bytes);
-  fs::remove_all(root);
 }
 
 // Issue 17: the summary says when the run started, its first start for a resumed run (kept in
 // the checkpoint), and when it finished, in ISO 8601 UTC, with the version, host and seed.
 TEST(Checkpoint, ResumedRunKeepsItsStartTime) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_started";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   make_interrupted_run(cfg, root / "run");
   std::this_thread::sleep_for(std::chrono::milliseconds(1100));
@@ -639,15 +610,13 @@ TEST(Checkpoint, ResumedRunKeepsItsStartTime) {
   EXPECT_EQ(js["version"], version());
   EXPECT_EQ(js["git_hash"], git_hash());
   EXPECT_EQ(js["host"], host_name());
-  fs::remove_all(root);
 }
 
 // A checkpoint of the sheardiff before issue 17 holds its configuration with 17-digit floats
 // (phi_init = 0.71999999999999997) and no start time: it resumes to the same results, the
 // start unknown (null), rather than being refused as another configuration.
 TEST(Checkpoint, CheckpointWithOldFloatTextStillResumes) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_old_text";
-  fs::remove_all(root);
+  const ScratchDir root;
   const fs::path cfg = write_config(root);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   make_interrupted_run(cfg, root / "old");
@@ -686,15 +655,12 @@ TEST(Checkpoint, CheckpointWithOldFloatTextStillResumes) {
   nlohmann::json js;
   std::ifstream(root / "old" / "summary.json") >> js;
   EXPECT_TRUE(js["started"].is_null()) << js["started"];
-  fs::remove_all(root);
 }
 
 // Issue 16: SIGTERM while the initial packing was built killed the process (143) with no
 // checkpoint. It now waits for the set-up and checkpoints at step 0.
 TEST(Checkpoint, SigtermDuringSetUpWritesCheckpoint) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_setup_term";
-  fs::remove_all(root);
-  fs::create_directories(root);
+  const ScratchDir root;
   const fs::path cfg = root / "slow_setup.toml";
   // Compressing 1000 discs to phi = 0.8 takes seconds; the run itself 3 steps.
   std::ofstream(cfg) << R"([scene]
@@ -718,7 +684,6 @@ diffusion = false
   nlohmann::json js;
   std::ifstream(root / "run" / "summary.json") >> js;
   EXPECT_EQ(js["steps"], 3);
-  fs::remove_all(root);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/analysis/power_law.hpp"
 #include "sheardiff/observe/diffusion_observer.hpp"
 #include "sheardiff/run.hpp"
@@ -40,8 +41,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   // The samples are the frames, so that analyse can see them again.
   c.analysis.sample_strain = 0.01;
   c.analysis.velocity_intervals = {0.03};
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_diffusion_run";
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir;
   const nlohmann::json during = run_to_directory(c, dir, false);
   ASSERT_TRUE(during.contains("D"));
   ASSERT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
@@ -81,7 +81,6 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   EXPECT_EQ(written["analysed_with"][0], "analysis.msd_window_lo=0.25");
   EXPECT_TRUE(std::filesystem::exists(dir / "reanalysis" / "analysis.h5"));
   EXPECT_THROW(reanalyse_run(dir, {"flow.J=0.2"}), ConfigError);
-  std::filesystem::remove_all(dir);
 }
 
 // A run sampled more finely than its frames (the default: ten samples per frame) cannot be
@@ -89,8 +88,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
 // DIR/reanalysis/, naming the keys that differ, and leaves the run's files alone.
 TEST(DiffusionRun, FinerSamplesThanFramesAnalyseBeside) {
   const Config c = sheared_60(0.02);
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_finer_samples";
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir;
   const nlohmann::json during = run_to_directory(c, dir, false);
   EXPECT_DOUBLE_EQ(during["analysis_sample_strain"].get<double>(), 0.002);
   EXPECT_GE(during["analysis_samples"].get<long>(), 590);
@@ -104,7 +102,6 @@ TEST(DiffusionRun, FinerSamplesThanFramesAnalyseBeside) {
   EXPECT_EQ(frames["analysis_sample_strain"].get<double>(), 0.02);
   EXPECT_NEAR(frames["psi"].get<double>(), during["psi"].get<double>(),
               0.25 * during["psi"].get<double>());
-  std::filesystem::remove_all(dir);
 }
 
 std::string file_text(const std::filesystem::path& f) {
@@ -143,8 +140,7 @@ Config small_cell(bool diffusion) {
 // signals, from the frames the observer sampled, the detection frame included) comes out of
 // analyse unchanged, so summary.json and analysis.h5 are left as they are.
 TEST(DiffusionRun, AnalyseReproducesThePressureCellExactly) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_cell";
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir;
   const nlohmann::json during = run_to_directory(small_cell(true), dir, false);
   ASSERT_TRUE(during["steady"].get<bool>());
   ASSERT_TRUE(during["phi_err"].is_number()) << during.dump();
@@ -186,14 +182,12 @@ TEST(DiffusionRun, AnalyseReproducesThePressureCellExactly) {
   ASSERT_TRUE(std::filesystem::exists(dir / "reanalysis" / "analysis.h5"));
   const auto written = nlohmann::json::parse(file_text(dir / "reanalysis" / "summary.json"));
   EXPECT_EQ(written["phi_err"], during["phi_err"]);
-  std::filesystem::remove_all(dir);
 }
 
 // A run made without the diffusion analysis gets it from analyse: its keys are added and
 // analysis.h5 written, the run's own keys stay as they were.
 TEST(DiffusionRun, AnalyseAddsWhatTheRunDidNotCompute) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_adds";
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir;
   const nlohmann::json during = run_to_directory(small_cell(false), dir, false);
   ASSERT_TRUE(during["steady"].get<bool>());
   ASSERT_FALSE(during.contains("D"));
@@ -206,14 +200,12 @@ TEST(DiffusionRun, AnalyseAddsWhatTheRunDidNotCompute) {
   EXPECT_TRUE(written.contains("D"));
   EXPECT_TRUE(written.contains("analysed_by"));
   EXPECT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
-  std::filesystem::remove_all(dir);
 }
 
 // A window of fewer than 8 frames has no error bars: the summary says why (no "+- nan"), and
 // analyse, counting the same frames, agrees.
 TEST(DiffusionRun, TooFewFramesForErrorBarsIsSaidAndReproduced) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_few";
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir;
   Config c = small_cell(false);
   c.output.frame_strain = 0.25;
   c.steady.measure_strain = 1.0;
@@ -226,20 +218,16 @@ TEST(DiffusionRun, TooFewFramesForErrorBarsIsSaidAndReproduced) {
   const Reanalysis re = reanalyse_run(dir);
   EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
   EXPECT_FALSE(re.summary.contains("phi_err"));
-  std::filesystem::remove_all(dir);
 }
 
 // The channel has no diffusion analysis: analyse refuses its run before reading anything.
 TEST(DiffusionRun, AnalyseRefusesAChannelRun) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_analyse_channel";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const ScratchDir dir;
   { std::ofstream(dir / "config.toml") << "[scene]\ntype = \"channel\"\n"; }
   { std::ofstream(dir / "summary.json") << "{\"steps\": 1}"; }
   EXPECT_THROW(reanalyse_run(dir), ConfigError);
   EXPECT_EQ(file_text(dir / "summary.json"), "{\"steps\": 1}");
   EXPECT_FALSE(std::filesystem::exists(dir / "analysis.h5"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST(DiffusionRun, FrameStrainResolvedFromJ) {

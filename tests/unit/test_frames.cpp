@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/engine.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/run.hpp"
@@ -33,9 +34,7 @@ class FramesOfEachScene : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(FramesOfEachScene, FirstAtStepZeroThenEvenlySpaced) {
   const Config cfg = small(GetParam());
-  const fs::path dir =
-      fs::temp_directory_path() / (std::string("sheardiff_test_frames_") + GetParam());
-  fs::remove_all(dir);
+  const ScratchDir dir;
   run_to_directory(cfg, dir, false);
   const fs::path traj = dir / "trajectory.h5";
   // The initial configuration, as the engine builds it from the same config.
@@ -65,7 +64,6 @@ TEST_P(FramesOfEachScene, FirstAtStepZeroThenEvenlySpaced) {
   EXPECT_LT(worst, 1e-12) << "frames off their strains";
   const H5mdFrame second = read_h5md_frame(traj, 1), third = read_h5md_frame(traj, 2);
   EXPECT_NEAR(third.time - second.time, second.time - first.time, 1e-12 * third.time);
-  fs::remove_all(dir);
 }
 
 // A fixed integrator.dt is the step a convergence study asks for: never shortened to land on a

@@ -2,8 +2,6 @@
 #include <hdf5.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -12,34 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/io/h5md.hpp"
 
 namespace sheardiff {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Unique per process and test so parallel ctest runs do not collide.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const auto tick = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = fs::temp_directory_path() / ("sheardiff_h5md_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(tick) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 constexpr std::size_t kN = 5;
 constexpr int kFrames = 3;
@@ -138,7 +115,7 @@ void expect_frame(const H5mdFrame& fr, int f) {
 }
 
 TEST(H5md, RoundTripFrames) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   write_test_file(file);
 
@@ -153,7 +130,7 @@ TEST(H5md, RoundTripFrames) {
 }
 
 TEST(H5md, RoundTripObservables) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   write_test_file(file);
 
@@ -180,7 +157,7 @@ TEST(H5md, RoundTripObservables) {
 }
 
 TEST(H5md, LayoutViaCApi) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   write_test_file(file);
 
@@ -256,7 +233,7 @@ TEST(H5md, LayoutViaCApi) {
 }
 
 TEST(H5md, WriterRejectsBadFrames) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "bad.h5";
   H5mdWriter w(file, make_layout());
   std::vector<Vec2> p(kN, Vec2::Zero()), short_p(kN - 1, Vec2::Zero());
@@ -318,7 +295,7 @@ std::string unit_of(hid_t f, const std::string& name) {
 const std::string kG = "/particles/suspension/";
 
 TEST(H5md, BoxIsATriclinicMatrixAndStepTimeAreHardLinks) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   write_test_file(file);
   const hid_t f = H5Fopen(file.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -371,7 +348,7 @@ TEST(H5md, BoxIsATriclinicMatrixAndStepTimeAreHardLinks) {
 }
 
 TEST(H5md, EveryElementHasAUnitAndTheCodesNameThemselves) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   write_test_file(file);
   const hid_t f = H5Fopen(file.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
@@ -451,7 +428,7 @@ void expect_network(const ContactNetwork& got, int f) {
 }
 
 TEST(H5md, ContactNetworkRoundTripAndResume) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "traj.h5";
   TrajectoryLayout layout = make_layout();
   layout.write_contacts = true;
@@ -555,7 +532,7 @@ void write_foreign_file(const fs::path& file) {
 }
 
 TEST(H5md, ReadsAnotherWritersFileQuietly) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "foreign.h5";
   write_foreign_file(file);
   testing::internal::CaptureStderr();
@@ -578,7 +555,7 @@ TEST(H5md, ReadsAnotherWritersFileQuietly) {
 
 // The layout before issue 17: a cuboid box vector per frame with its own step and time.
 TEST(H5md, ReadsTheOldCuboidLayout) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "old.h5";
   const hid_t f = H5Fcreate(file.string().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   for (const char* g : {"/particles", "/particles/suspension", "/particles/suspension/box",
@@ -628,7 +605,7 @@ TEST(H5md, ReadsTheOldCuboidLayout) {
 }
 
 TEST(PositionTable, ReadsWithCommentsAndBlankLines) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "pos.txt";
   {
     std::ofstream out(file);
@@ -649,7 +626,7 @@ TEST(PositionTable, ReadsWithCommentsAndBlankLines) {
 }
 
 TEST(PositionTable, MalformedLineThrowsWithLineNumber) {
-  TempDir dir;
+  const ScratchDir dir;
   const fs::path file = dir.path() / "bad.txt";
   {
     std::ofstream out(file);

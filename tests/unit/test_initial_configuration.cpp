@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/io/h5md.hpp"
 #include "sheardiff/run.hpp"
 #include "sheardiff/setup/random_packing.hpp"
@@ -54,9 +55,7 @@ TEST(InitialConfiguration, SeededAndReproducible) {
 }
 
 TEST(InitialConfiguration, FromTableAndFromH5mdFrame) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_init";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const ScratchDir dir;
   // A table of 4 discs far apart in a cell given by phi_init.
   {
     std::ofstream t(dir / "start.txt");
@@ -95,16 +94,13 @@ TEST(InitialConfiguration, FromTableAndFromH5mdFrame) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("particles.N"), std::string::npos) << e.what();
   }
-  std::filesystem::remove_all(dir);
 }
 
 // Two discs at one spot stopped the run at step 0 with advice about integrator settings (issue
 // 35, case 10). Coincident discs, and discs overlapping across the periodic edge, are refused as
 // bad input naming the pair; a run's own overlaps (~1/ktilde) are not.
 TEST(InitialConfiguration, OverlappingDiscsInAFileAreRefused) {
-  const auto dir = std::filesystem::temp_directory_path() / "sheardiff_test_init_overlap";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const ScratchDir dir;
   Config c;
   c.particles.n = 4;
   c.particles.phi_init = 0.2;  // Lx = Ly = 4.82 d
@@ -136,7 +132,6 @@ TEST(InitialConfiguration, OverlappingDiscsInAFileAreRefused) {
   // Touching with a 1 % overlap (a dense run's last frame) is a start.
   { std::ofstream(dir / "start.txt") << "1 1 1\n1.99 1 1\n1 3 1.4\n3 3 1.4\n"; }
   EXPECT_NO_THROW(validate_run_inputs(c, "test"));
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/observe/pressure_cell.hpp"
 #include "sheardiff/run.hpp"
 
@@ -36,11 +37,9 @@ void settle(Simulation& sim) {
 }
 
 nlohmann::json run_summary(Config c, const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("sheardiff_test_" + name);
-  std::filesystem::remove_all(dir);
+  const ScratchDir dir(name);
   c.output.trajectory = false;
   nlohmann::json js = run_to_directory(c, dir, false);
-  std::filesystem::remove_all(dir);
   return js;
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/engine.hpp"
 #include "sheardiff/integrator/stress.hpp"
@@ -211,8 +212,7 @@ TEST(SphereRun, AFileOfSpheresSlidesSidewaysAndARecordKeepsTheLawItRan) {
   EXPECT_EQ(parse_config(spheres, "t.toml", {}, ConfigSource::record).contact.sliding_stiffness,
             "none");
 
-  const fs::path dir = fs::temp_directory_path() / "sheardiff_test_sphere_record";
-  fs::remove_all(dir);
+  const ScratchDir dir;
   Config old = sphere_cell(0.6);
   ASSERT_EQ(old.contact.sliding_stiffness, "none");
   run_to_directory(old, dir, false);
@@ -239,12 +239,10 @@ TEST(SphereRun, AFileOfSpheresSlidesSidewaysAndARecordKeepsTheLawItRan) {
   }
   const nlohmann::json extended = run_to_directory(sphere_cell(0.7), dir, false, true);
   EXPECT_GE(extended[summary_key::strain].get<double>(), 0.7 - 1e-9);
-  fs::remove_all(dir);
 }
 
 TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {
-  const fs::path dir = fs::temp_directory_path() / "sheardiff_test_sphere_run";
-  fs::remove_all(dir);
+  const ScratchDir dir;
   Config cfg = sphere_cell(1.5);
   cfg.output.contacts = true;
   const nlohmann::json js = run_to_directory(cfg, dir, false);
@@ -264,14 +262,12 @@ TEST(SphereRun, PressureCellOfSpheresCarriesTheLoadAndMeasuresAVolumeFraction) {
   EXPECT_TRUE(std::isfinite(js[summary_key::shear_stress].get<double>()));
   expect_trajectory_of_spheres(dir / "trajectory.h5", js);
   expect_contacts_of_spheres(dir / "trajectory.h5", cfg.contact.mu);
-  fs::remove_all(dir);
 }
 
 // Simple shear of spheres (scene/simple_shear.cpp): 100 spheres at volume fraction 0.45 in a
 // Lees-Edwards cube, J = 1e-2, ktilde = 1e3, one strain.
 TEST(SphereRun, SimpleShearOfSpheresInALeesEdwardsCube) {
-  const fs::path dir = fs::temp_directory_path() / "sheardiff_test_sphere_simple_shear";
-  fs::remove_all(dir);
+  const ScratchDir dir;
   Config c;
   c.scene.type = "simple_shear";
   c.scene.dimension = 3;
@@ -361,13 +357,12 @@ TEST(SphereRun, SimpleShearOfSpheresInALeesEdwardsCube) {
     EXPECT_NEAR(re.summary[key].get<double>(), js[key].get<double>(),
                 1e-9 * std::abs(js[key].get<double>()))
         << key;
-  fs::remove_all(dir);
 }
 
 // With either sliding law: "sideways" reads each contact's last cap ratio, which the
 // checkpoint must carry (layout 8) for the extension to stay on the longer run's trajectory.
 TEST(SphereRun, ExtendedRunOfSpheresIsTheLongerRunToTheBit) {
-  const fs::path root = fs::temp_directory_path() / "sheardiff_test_sphere_extend";
+  const ScratchDir root;
   for (const char* sliding : {"none", "sideways"}) {
     SCOPED_TRACE(sliding);
     fs::remove_all(root);
@@ -384,7 +379,6 @@ TEST(SphereRun, ExtendedRunOfSpheresIsTheLongerRunToTheBit) {
           summary_key::shear_stress, summary_key::max_overlap, summary_key::factorisations})
       EXPECT_EQ(extended[key], direct[key]) << key;
   }
-  fs::remove_all(root);
 }
 
 }  // namespace
