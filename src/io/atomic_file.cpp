@@ -9,9 +9,6 @@
 
 namespace sheardiff {
 
-namespace {
-
-// write(2) until done: a signal or a pipe may cut a write short.
 bool write_all(int fd, const char* data, std::size_t size) {
   while (size > 0) {
     const ssize_t n = ::write(fd, data, size);
@@ -22,8 +19,6 @@ bool write_all(int fd, const char* data, std::size_t size) {
   }
   return true;
 }
-
-}  // namespace
 
 void write_file_atomically(const std::filesystem::path& file, const char* data, std::size_t size) {
   const std::filesystem::path tmp = file.string() + ".tmp";

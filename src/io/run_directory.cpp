@@ -23,6 +23,7 @@
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/core/text.hpp"
+#include "sheardiff/io/atomic_file.hpp"
 #include "sheardiff/io/hdf5_diagnostics.hpp"
 #include "sheardiff/io/io_error.hpp"
 #include "sheardiff/io/run_files.hpp"
@@ -35,17 +36,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* const kLog = "run.log";
-
-bool write_all(int fd, const char* data, std::size_t size) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    data += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
 
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
