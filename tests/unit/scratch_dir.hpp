@@ -16,7 +16,8 @@ namespace sheardiff {
 // Named by the running test (and a tag where a test needs two) and by the process, so two test
 // processes on one machine (ctest -j2, two CI checkouts) never share one. It is empty when the
 // test starts, whatever an earlier run left, and removed when the test ends, also when an
-// assertion returned early; a failed test's folder is kept for a look and its path printed.
+// assertion returned early. A failed test's folder is kept for a look and its path printed; as
+// it is named by the process, a later run does not clear it: remove /tmp/sheardiff_* by hand.
 class ScratchDir {
  public:
   explicit ScratchDir(std::string_view tag = "") {

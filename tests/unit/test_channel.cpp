@@ -290,7 +290,8 @@ TEST(Channel, HistoryFileRoundTrip) {
   h.centre_distance = {4.0, 4.25};
   h.u_p_mean = {0.97, 0.98};
   for (auto& rows : h.profiles) rows = {{0.123456789, NAN}, {1.0 / 3.0, 2.0}};
-  const auto file = std::filesystem::temp_directory_path() / "sheardiff_test_channel_history.h5";
+  const ScratchDir dir;
+  const auto file = dir / "channel_history.h5";
   write_channel_history(h, file);
   EXPECT_EQ(read_dataset(file, "/channel_history/centre_distance"), h.centre_distance);
   for (const char* name : ChannelHistory::profile_names) {
@@ -304,7 +305,6 @@ TEST(Channel, HistoryFileRoundTrip) {
   std::filesystem::remove(file);
   h.profiles[2][1].pop_back();
   EXPECT_THROW(write_channel_history(h, file), std::logic_error);
-  std::filesystem::remove(file.string() + ".tmp");
 }
 
 }  // namespace

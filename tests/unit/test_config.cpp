@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/run.hpp"
 #include "sheardiff/run_extension.hpp"
@@ -367,8 +368,7 @@ namespace {
 // file printed the defaults.
 TEST(Config, ConfigFileMustBeAFileNamingItsScene) {
   namespace fs = std::filesystem;
-  const auto dir = fs::temp_directory_path() / "sheardiff_config_file";
-  fs::remove_all(dir);
+  const ScratchDir dir;
   fs::create_directories(dir / "dir.toml");
   const auto error_of = [](const fs::path& f, std::vector<std::string> sets = {}) {
     try {
@@ -387,7 +387,6 @@ TEST(Config, ConfigFileMustBeAFileNamingItsScene) {
   EXPECT_EQ(error_of(dir / "flow.toml", {"scene.type=simple_shear"}), "");
   std::ofstream(dir / "scene.toml") << "[scene]\ntype = \"pressure_shear\"\n";
   EXPECT_EQ(load_config(dir / "scene.toml").scene.type, "pressure_shear");
-  fs::remove_all(dir);
 }
 
 // Issue 16: frame_strain (or checkpoint_strain) = 1e-300 was in range and spun forever.

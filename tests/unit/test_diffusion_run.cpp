@@ -47,7 +47,7 @@ TEST(DiffusionRun, AnalyseReproducesObserverExactly) {
   ASSERT_TRUE(std::filesystem::exists(dir / "analysis.h5"));
   const Reanalysis re = reanalyse_run(dir);
   EXPECT_TRUE(re.differs.empty());
-  EXPECT_EQ(re.folder, dir);
+  EXPECT_EQ(re.folder, dir.path());
   const nlohmann::json& after = re.summary;
   for (const char* key :
        {"D", "D_err", "D_regression_stderr", "dv", "psi", "psi_e", "step_length", "msd_window",
@@ -194,7 +194,7 @@ TEST(DiffusionRun, AnalyseAddsWhatTheRunDidNotCompute) {
   ASSERT_FALSE(std::filesystem::exists(dir / "analysis.h5"));
   const Reanalysis re = reanalyse_run(dir);
   EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
-  EXPECT_EQ(re.folder, dir);
+  EXPECT_EQ(re.folder, dir.path());
   const auto written = nlohmann::json::parse(file_text(dir / "summary.json"));
   for (const auto& [key, value] : during.items()) EXPECT_EQ(value, written[key]) << key;
   EXPECT_TRUE(written.contains("D"));

@@ -352,7 +352,7 @@ TEST(SphereRun, SimpleShearOfSpheresInALeesEdwardsCube) {
   ASSERT_TRUE(js.contains(summary_key::psi)) << js.dump(1);
   const Reanalysis re = reanalyse_run(dir);
   EXPECT_TRUE(re.differs.empty()) << fmt::format("{}", fmt::join(re.differs, ", "));
-  EXPECT_EQ(re.folder, dir);
+  EXPECT_EQ(re.folder, dir.path());
   for (const char* key : {summary_key::D, summary_key::dv, summary_key::psi})
     EXPECT_NEAR(re.summary[key].get<double>(), js[key].get<double>(),
                 1e-9 * std::abs(js[key].get<double>()))

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "scratch_dir.hpp"
 #include "sheardiff/config.hpp"
 #include "sheardiff/sweep/sweep.hpp"
 
@@ -14,10 +15,8 @@ using namespace sheardiff;
 
 namespace {
 
-fs::path write_files(const std::string& name, const std::string& sweep) {
-  const auto dir = fs::temp_directory_path() / ("sheardiff_sweep_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+// base.toml and sweep.toml in DIR; returns sweep.toml.
+fs::path write_files(const fs::path& dir, const std::string& sweep) {
   std::ofstream(dir / "base.toml") << "[scene]\ntype = \"pressure_shear\"\n[particles]\nN = 40\n";
   std::ofstream(dir / "sweep.toml") << sweep;
   return dir / "sweep.toml";
@@ -35,7 +34,8 @@ std::string error_of(const fs::path& file) {
 }  // namespace
 
 TEST(Sweep, PointsAreTheProductLastAxisFastest) {
-  const auto file = write_files("product", R"(
+  const ScratchDir scratch;
+  const auto file = write_files(scratch, R"(
 [sweep]
 base = "base.toml"
 [sweep.set]
@@ -67,7 +67,8 @@ base = "base.toml"
 
 // A list key (analysis.velocity_intervals) set for every point reaches each point's config.
 TEST(Sweep, ListValuesAreSetAsLists) {
-  const auto file = write_files("list", R"(
+  const ScratchDir scratch;
+  const auto file = write_files(scratch, R"(
 [sweep]
 base = "base.toml"
 [sweep.set]
@@ -81,7 +82,7 @@ base = "base.toml"
   EXPECT_EQ(points[0].overrides[0], "analysis.velocity_intervals=[0.0035, 0.01]");
   const Config cfg = load_config(spec.base, points[0].overrides);
   EXPECT_EQ(cfg.analysis.velocity_intervals, (std::vector<double>{0.0035, 0.01}));
-  EXPECT_NE(error_of(write_files("list_bad",
+  EXPECT_NE(error_of(write_files(ScratchDir("list_bad"),
                                  "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
                                  "\"analysis.velocity_intervals\" = [\"a\"]\n"
                                  "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
@@ -90,35 +91,36 @@ base = "base.toml"
 }
 
 TEST(Sweep, BadSweepFilesNameTheKey) {
-  EXPECT_NE(error_of(write_files("unknown",
+  EXPECT_NE(error_of(write_files(ScratchDir("unknown"),
                                  "[sweep]\nbase = \"base.toml\"\nbsae = 1\n"
                                  "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
                 .find("unknown key 'bsae'"),
             std::string::npos);
-  EXPECT_NE(error_of(write_files("nobase",
+  EXPECT_NE(error_of(write_files(ScratchDir("nobase"),
                                  "[sweep]\nbase = \"nothere.toml\"\n"
                                  "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
                 .find("sweep.base = \"nothere.toml\": no such file"),
             std::string::npos);
-  EXPECT_NE(error_of(write_files("noaxes", "[sweep]\nbase = \"base.toml\"\n")).find("sweep.axes"),
+  EXPECT_NE(error_of(write_files(ScratchDir("noaxes"), "[sweep]\nbase = \"base.toml\"\n"))
+                .find("sweep.axes"),
             std::string::npos);
-  EXPECT_NE(error_of(write_files("emptyaxis",
+  EXPECT_NE(error_of(write_files(ScratchDir("emptyaxis"),
                                  "[sweep]\nbase = \"base.toml\"\n"
                                  "[sweep.axes]\n\"flow.J\" = []\n"))
                 .find("non-empty list"),
             std::string::npos);
-  EXPECT_NE(error_of(write_files("jobs",
+  EXPECT_NE(error_of(write_files(ScratchDir("jobs"),
                                  "[sweep]\nbase = \"base.toml\"\njobs = 0\n"
                                  "[sweep.axes]\n\"flow.J\" = [0.1]\n"))
                 .find("sweep.jobs = 0: must be in [1, 256]"),
             std::string::npos);
   // An axis value the config rejects is found before anything runs, with the point's name.
-  const auto e = error_of(write_files("badpoint",
+  const auto e = error_of(write_files(ScratchDir("badpoint"),
                                       "[sweep]\nbase = \"base.toml\"\n"
                                       "[sweep.axes]\n\"flow.J\" = [0.1, -1.0]\n"));
   EXPECT_NE(e.find("point J=-1"), std::string::npos) << e;
   EXPECT_NE(e.find("flow.J"), std::string::npos) << e;
-  EXPECT_NE(error_of(write_files("slurm",
+  EXPECT_NE(error_of(write_files(ScratchDir("slurm"),
                                  "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n"
                                  "\"flow.J\" = [0.1]\n[slurm]\nthrotle = 2\n"))
                 .find("unknown key 'throtle'"),
@@ -128,7 +130,8 @@ TEST(Sweep, BadSweepFilesNameTheKey) {
 // A key paired with an axis takes one value per entry of that axis (each J its own start), keeps
 // the point names, and a key given in two places is refused rather than one silently winning.
 TEST(Sweep, PairedValuesFollowTheirAxis) {
-  const auto file = write_files("paired", R"(
+  const ScratchDir scratch;
+  const auto file = write_files(scratch, R"(
 [sweep]
 base = "base.toml"
 [sweep.axes]
@@ -148,23 +151,26 @@ base = "base.toml"
 
   const std::string head =
       "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n\"flow.J\" = [1e-2, 0.1]\n";
-  auto e = error_of(write_files(
-      "paired_len", head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7]\n"));
+  auto e =
+      error_of(write_files(ScratchDir("paired_len"),
+                           head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7]\n"));
   EXPECT_NE(e.find("sweep.paired.\"flow.J\".\"particles.phi_init\": must be a list of 2 values"),
             std::string::npos)
       << e;
-  e = error_of(write_files("paired_axis",
+  e = error_of(write_files(ScratchDir("paired_axis"),
                            head + "[sweep.paired.\"run.seed\"]\n\"particles.phi_init\" = [0.7]\n"));
   EXPECT_NE(e.find("\"run.seed\" is not an axis"), std::string::npos) << e;
-  e = error_of(write_files("paired_set", head + "[sweep.set]\n\"particles.phi_init\" = 0.7\n"
-                                                "[sweep.paired.\"flow.J\"]\n"
-                                                "\"particles.phi_init\" = [0.7, 0.6]\n"));
+  e = error_of(
+      write_files(ScratchDir("paired_set"), head + "[sweep.set]\n\"particles.phi_init\" = 0.7\n"
+                                                   "[sweep.paired.\"flow.J\"]\n"
+                                                   "\"particles.phi_init\" = [0.7, 0.6]\n"));
   EXPECT_NE(e.find("also in [sweep.set]"), std::string::npos) << e;
-  e = error_of(write_files("set_and_axis", head + "[sweep.set]\n\"flow.J\" = 0.3\n"));
+  e = error_of(write_files(ScratchDir("set_and_axis"), head + "[sweep.set]\n\"flow.J\" = 0.3\n"));
   EXPECT_NE(e.find("sweep.set.\"flow.J\": also an axis"), std::string::npos) << e;
   // A bad paired value is found before anything runs, with the point's name.
-  e = error_of(write_files(
-      "paired_bad", head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7, 2.0]\n"));
+  e = error_of(
+      write_files(ScratchDir("paired_bad"),
+                  head + "[sweep.paired.\"flow.J\"]\n\"particles.phi_init\" = [0.7, 2.0]\n"));
   EXPECT_NE(e.find("point J=0.1"), std::string::npos) << e;
   EXPECT_NE(e.find("particles.phi_init"), std::string::npos) << e;
 }
@@ -173,38 +179,40 @@ base = "base.toml"
 // directory as the base config ran the default scene.
 TEST(Sweep, DuplicatePointsAndDirectoryBaseAreRefused) {
   EXPECT_NE(
-      error_of(write_files("dupj",
+      error_of(write_files(ScratchDir("dupj"),
                            "[sweep]\nbase = \"base.toml\"\n"
                            "[sweep.axes]\n\"flow.J\" = [0.1, 0.01, 1e-1]\n"))
           .find("sweep.axes.\"flow.J\": entries 1 and 3 of the list are the same value (0.1)"),
       std::string::npos);
-  EXPECT_NE(error_of(write_files("dupseed",
+  EXPECT_NE(error_of(write_files(ScratchDir("dupseed"),
                                  "[sweep]\nbase = \"base.toml\"\n"
                                  "[sweep.axes]\n\"flow.J\" = [0.1]\n\"run.seed\" = [1, 1]\n"))
                 .find("sweep.axes.\"run.seed\": entries 1 and 2"),
             std::string::npos);
   // Different values, one directory name.
-  EXPECT_NE(error_of(write_files("dupname",
+  EXPECT_NE(error_of(write_files(ScratchDir("dupname"),
                                  "[sweep]\nbase = \"base.toml\"\n"
                                  "[sweep.axes]\n\"particles.init_file\" = [\"a_b\", \"a-b\"]\n"))
                 .find("one directory name"),
             std::string::npos);
   // Different values, one configuration once the defaults are resolved.
   const std::string frame = fmt::format("{}", 0.035 * std::pow(0.1, 0.25));
-  const auto e = error_of(write_files("dupconfig",
+  const auto e = error_of(write_files(ScratchDir("dupconfig"),
                                       "[sweep]\nbase = \"base.toml\"\n[sweep.set]\n"
                                       "\"flow.J\" = 0.1\n[sweep.axes]\n"
                                       "\"output.frame_strain\" = [0.0, " +
                                           frame + "]\n"));
   EXPECT_NE(e.find("run the same configuration"), std::string::npos) << e;
+  const ScratchDir scratch;
   const auto dir =
-      write_files("dirbase", "[sweep]\nbase = \"folder\"\n[sweep.axes]\n\"flow.J\" = [0.1]\n");
+      write_files(scratch, "[sweep]\nbase = \"folder\"\n[sweep.axes]\n\"flow.J\" = [0.1]\n");
   fs::create_directories(dir.parent_path() / "folder");
   EXPECT_NE(error_of(dir).find("is a directory, not a config file"), std::string::npos);
 }
 
 TEST(Sweep, FreshAndForeignPointDirectories) {
-  const auto file = write_files("state",
+  const ScratchDir scratch;
+  const auto file = write_files(scratch,
                                 "[sweep]\nbase = \"base.toml\"\n[sweep.axes]\n"
                                 "\"flow.J\" = [0.1, 0.01]\n");
   const auto spec = load_sweep(file);
@@ -298,7 +306,8 @@ void fake_finished(const SweepSpec& spec, const SweepPoint& p, const fs::path& o
 }  // namespace
 
 TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
-  const auto file = write_files("store",
+  const ScratchDir scratch;
+  const auto file = write_files(scratch,
                                 "[sweep]\nbase = \"base.toml\"\nresults = \"stored\"\n"
                                 "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
                                 "\"run.seed\" = [1, 2, 3]\n");
@@ -359,7 +368,8 @@ TEST(Sweep, ResultsPersistAndRefitFromTheStoreAlone) {
 // rewrote its sweep.csv and fits.json with that part alone. The folder's other finished points
 // stay in both, with their axis values, and the fits come out as the whole sweep's.
 TEST(Sweep, APartialSweepKeepsTheFoldersOtherPointsInItsTables) {
-  const auto file = write_files("partial",
+  const ScratchDir scratch;
+  const auto file = write_files(scratch,
                                 "[sweep]\nbase = \"base.toml\"\n"
                                 "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
                                 "\"run.seed\" = [1, 2, 3]\n");
@@ -385,14 +395,14 @@ TEST(Sweep, APartialSweepKeepsTheFoldersOtherPointsInItsTables) {
   ASSERT_EQ(again["groups"].size(), 1u);
   EXPECT_EQ(again["groups"][0]["fits"], whole["groups"][0]["fits"]);
   EXPECT_EQ(again["groups"][0]["rows"].size(), 4u);
-  fs::remove_all(file.parent_path());
 }
 
 // A refit over two stores: the re-measured store (listed first) replaces the older one's J, a
 // point whose window failed the stationarity test is left out, and so is an older point whose
 // walls' mu differ beyond steady.drift_z (3) combined errors; the fits are the sweep's own.
 TEST(Sweep, FitOverStoresTakesEachJFromTheFirstAndDropsDriftingPoints) {
-  const auto old_file = write_files("fit_old",
+  const ScratchDir scratch;
+  const auto old_file = write_files(scratch,
                                     "[sweep]\nbase = \"base.toml\"\nresults = \"old_store\"\n"
                                     "[sweep.axes]\n\"flow.J\" = [1e-4, 1e-3, 1e-2, 1e-1]\n"
                                     "\"run.seed\" = [1, 2]\n");
@@ -493,7 +503,8 @@ TEST(Sweep, SeedBootstrapQuotesTheUnbiasedErrorWithTwoSeeds) {
 TEST(Sweep, ASweepOfSeedsOnlyStoresItsPointsWithoutJFits) {
   // Channel cases are swept over seeds: their summaries have no J, so the collected fits.json
   // has no groups and does not repeat the shear paper's Table 1, while every point is stored.
-  const auto file = write_files("seeds_only",
+  const ScratchDir scratch;
+  const auto file = write_files(scratch,
                                 "[sweep]\nbase = \"base.toml\"\nresults = \"stored\"\n"
                                 "[sweep.axes]\n\"run.seed\" = [1, 2]\n");
   const auto spec = load_sweep(file);

@@ -5,8 +5,8 @@
 
 namespace sheardiff {
 
-// write(2) of all SIZE bytes to FD: a signal or a pipe may cut one call short. False on an error
-// (errno says which).
+// write(2) of all SIZE bytes to FD: a signal or a pipe may cut one call short. False if a call
+// fails (errno says why) or writes nothing.
 bool write_all(int fd, const char* data, std::size_t size);
 
 // Writes to FILE.tmp, flushes it to disk, then renames it over FILE: a reader (or a run killed
