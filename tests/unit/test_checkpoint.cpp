@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -92,6 +93,26 @@ pid_t spawn_resume(const fs::path& cfg, const fs::path& dir,
   return spawn_run(cfg, args, err);
 }
 
+// Waits until the run writing DIR has replaced its checkpoint.bin N times (each is a new file,
+// renamed over the last); false if that has not happened within a minute.
+bool wait_for_checkpoints(const fs::path& dir, int n) {
+  const std::string file = (dir / "checkpoint.bin").string();
+  struct stat last {};
+  int seen = 0;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+  while (seen < n && std::chrono::steady_clock::now() < end) {
+    struct stat st {};
+    if (::stat(file.c_str(), &st) == 0 &&
+        (st.st_ino != last.st_ino || st.st_mtim.tv_sec != last.st_mtim.tv_sec ||
+         st.st_mtim.tv_nsec != last.st_mtim.tv_nsec)) {
+      ++seen;
+      last = st;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  return seen >= n;
+}
+
 int wait_exit(pid_t pid) {
   int status = 0;
   waitpid(pid, &status, 0);
@@ -147,15 +168,16 @@ TEST(Checkpoint, SigkillAtRandomMomentThenResumeIsBitIdentical) {
   std::mt19937 rng(std::random_device{}());
   const pid_t pid = spawn(cfg, root / "killed");
   // Kill at a random moment after the first checkpoint exists (before it, there is nothing to
-  // resume and a user would simply start again).
-  for (int k = 0; k < 2000 && !fs::exists(root / "killed" / "checkpoint.bin"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // resume and a user would simply start again) and before the run ends, on a machine of any
+  // speed: after 1 to 15 of the 20 checkpoint writes of a whole run, then up to 5 ms on (a few
+  // steps), so that the kill may land in any part of a step or of a checkpoint's write.
+  const int writes = std::uniform_int_distribution<int>(1, 15)(rng);
+  const bool before_end = wait_for_checkpoints(root / "killed", writes);
   std::this_thread::sleep_for(
-      std::chrono::milliseconds(std::uniform_int_distribution<int>(0, 400)(rng)));
+      std::chrono::microseconds(std::uniform_int_distribution<int>(0, 5000)(rng)));
   kill(pid, SIGKILL);
-  const int killed = wait_exit(pid);
-  if (killed == 0) GTEST_SKIP() << "the run finished before the kill landed (machine too fast)";
-  ASSERT_EQ(killed, 128 + SIGKILL);
+  ASSERT_TRUE(before_end) << "the run ended before its checkpoint write " << writes;
+  ASSERT_EQ(wait_exit(pid), 128 + SIGKILL) << "after checkpoint write " << writes;
   ASSERT_TRUE(fs::exists(root / "killed" / "checkpoint.bin"));
   EXPECT_FALSE(fs::exists(root / "killed" / "summary.json"))
       << "a killed run must not look finished";
@@ -169,13 +191,10 @@ TEST(Checkpoint, SigtermWritesCheckpointAndExitsCleanly) {
   const fs::path cfg = write_config(root);
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   const pid_t pid = spawn(cfg, root / "stopped");
-  for (int k = 0; k < 2000 && !fs::exists(root / "stopped" / "trajectory.h5"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const bool before_end = wait_for_checkpoints(root / "stopped", 3);
   kill(pid, SIGTERM);
-  const int code = wait_exit(pid);
-  if (code == 0) GTEST_SKIP() << "the run finished before SIGTERM landed";
-  ASSERT_EQ(code, 128 + SIGTERM);
+  ASSERT_TRUE(before_end) << "the run ended before its third checkpoint write";
+  ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
   ASSERT_TRUE(fs::exists(root / "stopped" / "checkpoint.bin"));
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
   expect_same_final_state(root / "whole", root / "stopped");
@@ -387,15 +406,14 @@ std::vector<int> image_counts(const fs::path& traj) {
 TEST(Checkpoint, ImageCountsSurviveAResume) {
   const ScratchDir root;
   const fs::path cfg = write_config(root, "simple_shear");
-  const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
-  const auto whole = std::chrono::steady_clock::now() - t0;
   const pid_t pid = spawn(cfg, root / "stopped");
-  std::this_thread::sleep_for(whole * 7 / 10);
+  // Late in the run, where discs have crossed, on a machine of any speed or load: after 14 of
+  // the 20 checkpoint writes of a whole run (past strain 1.3 of 2).
+  const bool late = wait_for_checkpoints(root / "stopped", 14);
   kill(pid, SIGTERM);
-  const int code = wait_exit(pid);
-  if (code == 0) GTEST_SKIP() << "the run finished before SIGTERM landed";
-  ASSERT_EQ(code, 128 + SIGTERM);
+  ASSERT_TRUE(late) << "the run ended before its 14th checkpoint";
+  ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
   const auto a = image_counts(root / "whole" / "trajectory.h5");
   EXPECT_EQ(a, image_counts(root / "stopped" / "trajectory.h5"));
