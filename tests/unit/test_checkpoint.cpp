@@ -456,10 +456,10 @@ checkpoint_strain = 20.0
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   // Killed once its first checkpoint (strain 20) exists: resumed from there.
   const pid_t pid = spawn(cfg, root / "stopped");
-  for (int k = 0; k < 20000 && !fs::exists(root / "stopped" / "checkpoint.bin"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const bool before_end = wait_for_checkpoints(root / "stopped", 1);
   kill(pid, SIGKILL);
-  if (wait_exit(pid) == 0) GTEST_SKIP() << "the run finished before the kill landed";
+  ASSERT_TRUE(before_end) << "the run ended before its first checkpoint";
+  ASSERT_EQ(wait_exit(pid), 128 + SIGKILL);
   ASSERT_TRUE(fs::exists(root / "stopped" / "checkpoint.bin"));
   ASSERT_EQ(wait_exit(spawn_resume(cfg, root / "stopped")), 0);
   const long n = count_h5md_frames(root / "whole" / "trajectory.h5");
