@@ -21,6 +21,8 @@ writes). Per group (ktilde, N, ...):
                                                                    # against the discs'
     /usr/bin/python3 tools/results_table.py --error-check DIR [J_MIN J_MAX]  # the runs' own
                                                    # error bars against the seeds' scatter
+    /usr/bin/python3 tools/results_table.py --bulk DIR     # D of every particle against D of
+                                                           # the bulk band's alone
 
 --error-check asks whether one run's error bars (from its time blocks) hold the scatter between
 seeds. Per quantity and J (the stationary windows the fits used, two seeds or more): chi2 =
@@ -149,7 +151,7 @@ def main():
             rows = [r for r in rows if lo <= (cell(r, "J") or math.nan) <= hi]
         error_check(rows)
         return
-    modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges")
+    modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges", "--bulk")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
     if only:
         del sys.argv[1]
@@ -186,6 +188,8 @@ def main():
             means_table(g["rows"])
         elif only == "--ranges":
             subrange_fits(store.fitted_rows(), heading=False)
+        elif only == "--bulk":
+            bulk_table(store.fitted_rows())
         else:
             against_boyer(g["rows"], False)
         return
@@ -492,6 +496,31 @@ def runs_by_j(done):
     for r in done:
         by_j.setdefault(cell(r, "J"), []).append(r)
     return by_j
+
+
+def bulk_table(done):
+    """Per J over the windows the fits used: D from every particle's MSD and D_bulk from the MSD
+    of those in the bulk band alone (3 d inside each wall line), each the mean over seeds +- the
+    seeds' scatter over sqrt(n) (D_bulk has no error bar of its own), and their ratio per run.
+    Whether the walls' layers set how D changes with J: the bulk's D would then change
+    otherwise."""
+    print("| J | seeds | D / (gammadot d^2), every particle | D_bulk, the bulk band's | "
+          "D_bulk / D |")
+    print("|---|---|---|---|---|")
+    for J, runs in sorted(runs_by_j(done).items()):
+        pairs = np.array([(cell(r, "D"), cell(r, "D_bulk")) for r in runs
+                          if cell(r, "D") is not None and cell(r, "D_bulk") is not None])
+        if J is None or len(pairs) == 0:
+            continue
+        n = len(pairs)
+        ratio = pairs[:, 1] / pairs[:, 0]
+
+        def sem(x):
+            return float(np.std(x, ddof=1) / math.sqrt(n)) if n > 1 else None
+
+        print(f"| {J:g} | {n} | {pm(pairs[:, 0].mean(), sem(pairs[:, 0]))} | "
+              f"{pm(pairs[:, 1].mean(), sem(pairs[:, 1]))} | "
+              f"{pm(ratio.mean(), sem(ratio))} |")
 
 
 ERROR_CHECKED = (("phi", "phi"), ("mu", "mu"), ("D", "D / (gammadot d^2)"),
