@@ -22,7 +22,7 @@ writes). Per group (ktilde, N, ...):
     /usr/bin/python3 tools/results_table.py --error-check DIR [J_MIN J_MAX]  # the runs' own
                                                    # error bars against the seeds' scatter
     /usr/bin/python3 tools/results_table.py --bulk DIR     # D of every particle against D of
-                                                           # the bulk band's alone
+                                                           # the bulk band's spheres alone
 
 --error-check asks whether one run's error bars (from its time blocks) hold the scatter between
 seeds. Per quantity and J (the stationary windows the fits used, two seeds or more): chi2 =
@@ -500,17 +500,18 @@ def runs_by_j(done):
 
 def bulk_table(done):
     """Per J over the windows the fits used: D from every particle's MSD and D_bulk from the MSD
-    of those in the bulk band alone (3 d inside each wall line), each the mean over seeds +- the
-    seeds' scatter over sqrt(n) (D_bulk has no error bar of its own), and their ratio per run.
-    Whether the walls' layers set how D changes with J: the bulk's D would then change
-    otherwise."""
+    of those in the bulk band alone (observables.wall_exclusion, 3 d by default, inside each
+    wall line), each the mean over seeds +- the seeds' scatter over sqrt(n) (D_bulk has no error
+    bar of its own), and their ratio per run. Whether the spheres next to the walls set how D
+    changes with J: the bulk's D would then change otherwise."""
     print("| J | seeds | D / (gammadot d^2), every particle | D_bulk, the bulk band's | "
           "D_bulk / D |")
     print("|---|---|---|---|---|")
-    for J, runs in sorted(runs_by_j(done).items()):
-        pairs = np.array([(cell(r, "D"), cell(r, "D_bulk")) for r in runs
+    by_j = runs_by_j(done)
+    for J in sorted(j for j in by_j if j is not None):
+        pairs = np.array([(cell(r, "D"), cell(r, "D_bulk")) for r in by_j[J]
                           if cell(r, "D") is not None and cell(r, "D_bulk") is not None])
-        if J is None or len(pairs) == 0:
+        if len(pairs) == 0:
             continue
         n = len(pairs)
         ratio = pairs[:, 1] / pairs[:, 0]
