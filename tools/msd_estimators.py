@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """D of each finished point of a store from its two MSD estimators, over the run's own fit window
-(summary.json's msd_window): D, the every-origin MSD of the coarse samples (`/msd_coarse`, what
-the run fits), beside the multiple-tau MSD of every particle (`/msd/msd`) and of the bulk band's
+(summary.json's msd_window): D, what the run fitted (the every-origin MSD of the coarse samples,
+`/msd_coarse`; runs older than it fitted `/msd/msd`, which then reads a ratio of exactly 1), beside the multiple-tau MSD of every particle (`/msd/msd`) and of the bulk band's
 alone (`/msd/msd_bulk`, what D_bulk is fitted to). Whether D_bulk / D is the bulk's own or the
 estimators' difference: the multiple-tau D of every particle over D says how far the two
 estimators part.
@@ -41,7 +41,8 @@ def main():
     rows = []
     for path in a.stores:
         for run in rundir.Store(path).points():
-            if run.has("analysis") and run.summary.get("msd_window"):
+            js = run.summary
+            if run.has("analysis") and js.get("msd_window") and js.get("D") is not None:
                 rows.append((run.path.name, *point_row(run)))
     if not rows:
         raise SystemExit(f"{', '.join(map(str, a.stores))}: no finished point with an analysis.h5")
@@ -49,7 +50,7 @@ def main():
           "D_bulk, multiple-tau | D_bulk / multiple-tau D |")
     print("|---|---|---|---|---|---|")
     for name, _, d, every, bulk in sorted(rows, key=lambda r: (r[1], r[0])):
-        b = "-" if bulk is None else f"{bulk:.4g} | {bulk / every:.3f}"
+        b = "- | -" if bulk is None else f"{bulk:.4g} | {bulk / every:.3f}"
         print(f"| {name} | {d:.4g} | {every:.4g} | {every / d:.3f} | {b} |")
     ratios = np.array([every / d for _, _, d, every, _ in rows])
     print(f"\nmultiple-tau / every-origin D over {len(ratios)} points: mean {ratios.mean():.3f}, "

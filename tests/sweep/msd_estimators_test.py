@@ -3,7 +3,7 @@
 D is 0.05 and whose multiple-tau MSDs are straight lines of slope 2 x 0.051 (every particle) and
 2 x 0.0612 (the bulk) over its fit window [8, 15], curving away outside it (which a fit over the
 wrong lags would pick up): ratios 1.020 and 1.200. A point without analysis.h5 is passed over and
-a store with none is refused. Usage: msd_estimators_test.py REPO WORK"""
+a store with none is refused; a point without a bulk MSD has dashes there. Usage: msd_estimators_test.py REPO WORK"""
 import json
 import pathlib
 import shutil
@@ -27,6 +27,13 @@ with h5py.File(point / "analysis.h5", "w") as f:
     f["msd/lag"] = lag
     f["msd/msd"] = 2 * 0.051 * lag + 0.2 + bend
     f["msd/msd_bulk"] = 2 * 0.0612 * lag + 0.1 + bend
+# A run of discs without walls (simple shear): no bulk MSD, its cells a dash.
+lone = store / "points" / "J=0.03_seed=1"
+lone.mkdir()
+(lone / "summary.json").write_text(json.dumps({"J": 0.03, "D": 0.02, "msd_window": [8.0, 15.0]}))
+with h5py.File(lone / "analysis.h5", "w") as f:
+    f["msd/lag"] = lag
+    f["msd/msd"] = 2 * 0.02 * lag
 bare = store / "points" / "J=0.02_seed=1"
 bare.mkdir()
 (bare / "summary.json").write_text(json.dumps({"J": 0.02, "D": 0.04, "msd_window": [8.0, 15.0]}))
@@ -36,8 +43,11 @@ line = next(l for l in out.splitlines() if l.startswith("| J=0.01_seed=1 |"))
 cells = [c.strip() for c in line.strip("|").split("|")]
 assert cells[1:] == ["0.05", "0.051", "1.020", "0.0612", "1.200"], cells
 assert "J=0.02" not in out, out
-assert "over 1 points: mean 1.020, range 1.020-1.020" in out, out
+line = next(l for l in out.splitlines() if l.startswith("| J=0.03_seed=1 |"))
+assert [c.strip() for c in line.strip("|").split("|")][1:] == ["0.02", "0.02", "1.000", "-", "-"]
+assert "over 2 points: mean 1.010, range 1.000-1.020" in out, out
 shutil.rmtree(point)
+shutil.rmtree(lone)
 r = subprocess.run(tool + [str(store)], capture_output=True, text=True)
 assert r.returncode != 0 and "no finished point with an analysis.h5" in r.stderr, r
 print("msd_estimators: the two estimators' D over the run's window as expected")

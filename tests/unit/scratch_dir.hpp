@@ -18,6 +18,7 @@ namespace sheardiff {
 // test starts, whatever an earlier run left, and removed when the test ends, also when an
 // assertion returned early. A failed test's folder is kept for a look and its path printed; as
 // it is named by the process, a later run does not clear it: remove /tmp/sheardiff_* by hand.
+// A temporary ScratchDir inside a check's expression is gone before that check fails.
 class ScratchDir {
  public:
   explicit ScratchDir(std::string_view tag = "") {

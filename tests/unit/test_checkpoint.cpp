@@ -204,10 +204,10 @@ TEST(Checkpoint, ResumeRefusesAnotherConfiguration) {
   const ScratchDir root;
   const fs::path cfg = write_config(root);
   const pid_t pid = spawn(cfg, root / "run");
-  for (int k = 0; k < 2000 && !fs::exists(root / "run" / "checkpoint.bin"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const bool before_end = wait_for_checkpoints(root / "run", 1);
   kill(pid, SIGKILL);
-  wait_exit(pid);
+  ASSERT_TRUE(before_end) << "the run ended before its first checkpoint";
+  ASSERT_EQ(wait_exit(pid), 128 + SIGKILL);
   // Resuming with a different J is a configuration error (exit 2), not a silent mix.
   EXPECT_EQ(wait_exit(spawn_resume(cfg, root / "run", {"--set", "flow.J=0.1"})), 2);
 }
@@ -229,9 +229,9 @@ std::string text_of(const fs::path& f) {
 // DIR stopped by SIGTERM at (or just after) its first periodic checkpoint.
 void make_interrupted_run(const fs::path& cfg, const fs::path& dir) {
   const pid_t pid = spawn(cfg, dir);
-  for (int k = 0; k < 2000 && !fs::exists(dir / "checkpoint.bin"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const bool before_end = wait_for_checkpoints(dir, 1);
   kill(pid, SIGTERM);
+  ASSERT_TRUE(before_end) << "the run ended before its first checkpoint";
   ASSERT_EQ(wait_exit(pid), 128 + SIGTERM);
   ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
 }
@@ -372,9 +372,7 @@ TEST(Checkpoint, MessagesNameTheFileAndWhereTheRunWent) {
   // Renamed once its first checkpoint exists: the next checkpoint cannot be written there.
   const fs::path dir = root / "run", moved = root / "moved";
   const pid_t pid = spawn_run(cfg, {"--out", dir.string()}, err);
-  for (int k = 0; k < 4000 && !fs::exists(dir / "checkpoint.bin"); ++k)
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  ASSERT_TRUE(wait_for_checkpoints(dir, 1)) << "the run ended before its first checkpoint";
   fs::rename(dir, moved);
   EXPECT_EQ(wait_exit(pid), 1);
   const std::string m = text_of(err);
@@ -409,7 +407,7 @@ TEST(Checkpoint, ImageCountsSurviveAResume) {
   ASSERT_EQ(wait_exit(spawn(cfg, root / "whole")), 0);
   const pid_t pid = spawn(cfg, root / "stopped");
   // Late in the run, where discs have crossed, on a machine of any speed or load: after 14 of
-  // the 20 checkpoint writes of a whole run (past strain 1.3 of 2).
+  // the 20 checkpoint writes of a whole run (at strain 1.4 of 2 or later).
   const bool late = wait_for_checkpoints(root / "stopped", 14);
   kill(pid, SIGTERM);
   ASSERT_TRUE(late) << "the run ended before its 14th checkpoint";
