@@ -21,6 +21,8 @@ writes). Per group (ktilde, N, ...):
                                                                    # against the discs'
     /usr/bin/python3 tools/results_table.py --error-check DIR [J_MIN J_MAX]  # the runs' own
                                                    # error bars against the seeds' scatter
+    /usr/bin/python3 tools/results_table.py --steps DIR    # the exponents between neighbouring
+                                                           # J
     /usr/bin/python3 tools/results_table.py --bulk DIR     # D of every particle against D of
                                                            # the bulk band's spheres alone
 
@@ -151,7 +153,7 @@ def main():
             rows = [r for r in rows if lo <= (cell(r, "J") or math.nan) <= hi]
         error_check(rows)
         return
-    modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges", "--bulk")
+    modes = ("--laws", "--every-j", "--means", "--boyer", "--ranges", "--steps", "--bulk")
     only = sys.argv[1] if len(sys.argv) == 3 and sys.argv[1] in modes else None
     if only:
         del sys.argv[1]
@@ -188,6 +190,8 @@ def main():
             means_table(g["rows"])
         elif only == "--ranges":
             subrange_fits(store.fitted_rows(), heading=False)
+        elif only == "--steps":
+            local_exponents(g["rows"])
         elif only == "--bulk":
             bulk_table(store.fitted_rows())
         else:
@@ -496,6 +500,29 @@ def runs_by_j(done):
     for r in done:
         by_j.setdefault(cell(r, "J"), []).append(r)
     return by_j
+
+
+def local_exponents(rows):
+    """The exponent b of q ~ J^b between each pair of neighbouring J, from the means over seeds,
+    with the error of ln(q2 / q1) / ln(J2 / J1) from each mean's standard error (the larger of
+    the seeds' scatter and the runs' own bars, `standard_error`): where along the J range a law
+    steepens or flattens, which one fit over the range averages away."""
+    print("| J from - to | D: b | dv: b | Psi: b |")
+    print("|---|---|---|---|")
+    rows = sorted(rows, key=lambda r: r["J"])
+    for a, b in zip(rows, rows[1:]):
+        span = math.log(b["J"] / a["J"])
+        cells = []
+        for q in ("D", "dv", "psi"):
+            if a.get(q) is None or b.get(q) is None:
+                cells.append("-")
+                continue
+            ea, eb = standard_error(a, q), standard_error(b, q)
+            err = (math.hypot(ea / a[q], eb / b[q]) / abs(span)
+                   if ea is not None and eb is not None else None)
+            slope = math.log(b[q] / a[q]) / span
+            cells.append(f"{slope:+.3f}" + (f" +- {err:.3f}" if err is not None else ""))
+        print(f"| {a['J']:g} - {b['J']:g} | " + " | ".join(cells) + " |")
 
 
 def bulk_table(done):

@@ -121,6 +121,19 @@ def near(cell, want, tol):
     assert abs(float(cell) - want) <= tol, (cell, want)
 
 
+# --steps: D = 0.1 J^-1/2 at J = 0.01 and 0.04, each +- 1 % (the seeds' scatter, larger than
+# the runs' 0.5 %), then flat to J = 0.16 (exponent 0): -0.5 +- sqrt(2) x 0.01 / ln 4 = 0.0102
+# and +0.000 +- 0.0102; no dv or Psi in the store.
+steps = work / "steps"
+store(steps, [d_row(0.01, 1.0, 3), d_row(0.04, 1.0, 3),
+              dict(d_row(0.04, 1.0, 3), J=0.16)])
+fits = json.loads((steps / "fits.json").read_text())
+fits["seed_table1"] = {n: law for n in names}
+(steps / "fits.json").write_text(json.dumps(fits))
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--steps",
+                      str(steps)], capture_output=True, text=True, check=True).stdout
+assert cells_of(out, "0.01 - 0.04") == ["0.01 - 0.04", "-0.500 +- 0.010", "-", "-"], out
+assert cells_of(out, "0.04 - 0.16") == ["0.04 - 0.16", "+0.000 +- 0.010", "-", "-"], out
 check = work / "error_check"
 check.mkdir(exist_ok=True)
 (check / "fits.json").write_text(json.dumps({"points": 6, "finished": 6, "groups": []}))
@@ -186,5 +199,5 @@ out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--b
                      capture_output=True, text=True, check=True).stdout
 assert cells_of(out, "0.01") == ["0.01", "2", "0.05 +- 0.01", "0.06 +- 0.01", "1.21 +- 0.042"], out
 assert cells_of(out, "0.02") == ["0.02", "1", "0.03", "0.036", "1.2"], out
-print("results_table: per-J ratios, cost table, refusal, --compare, --discs, --error-check and "
-      "--bulk as expected")
+print("results_table: per-J ratios, cost table, refusal, --compare, --discs, --steps, "
+      "--error-check and --bulk as expected")
