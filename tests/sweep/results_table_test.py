@@ -122,18 +122,20 @@ def near(cell, want, tol):
 
 
 # --steps: D = 0.1 J^-1/2 at J = 0.01 and 0.04, each +- 1 % (the seeds' scatter, larger than
-# the runs' 0.5 %), then flat to J = 0.16 (exponent 0): -0.5 +- sqrt(2) x 0.01 / ln 4 = 0.0102
-# and +0.000 +- 0.0102; no dv or Psi in the store.
+# the runs' 0.5 %): -0.5 +- sqrt(2) x 0.01 / ln 4 = 0.0102. Then flat to J = 0.16, a single
+# seed (no scatter) whose own bar is 3 %: +0.000 +- hypot(0.01, 0.03) / ln 4 = 0.0228. No dv or
+# Psi in the store.
 steps = work / "steps"
-store(steps, [d_row(0.01, 1.0, 3), d_row(0.04, 1.0, 3),
-              dict(d_row(0.04, 1.0, 3), J=0.16)])
+single = dict(d_row(0.04, 1.0, 1), J=0.16, D_sem=None)
+single["D_run_err"] = 0.03 * single["D"]
+store(steps, [d_row(0.01, 1.0, 3), d_row(0.04, 1.0, 3), single])
 fits = json.loads((steps / "fits.json").read_text())
 fits["seed_table1"] = {n: law for n in names}
 (steps / "fits.json").write_text(json.dumps(fits))
 out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--steps",
                       str(steps)], capture_output=True, text=True, check=True).stdout
 assert cells_of(out, "0.01 - 0.04") == ["0.01 - 0.04", "-0.500 +- 0.010", "-", "-"], out
-assert cells_of(out, "0.04 - 0.16") == ["0.04 - 0.16", "+0.000 +- 0.010", "-", "-"], out
+assert cells_of(out, "0.04 - 0.16") == ["0.04 - 0.16", "+0.000 +- 0.023", "-", "-"], out
 check = work / "error_check"
 check.mkdir(exist_ok=True)
 (check / "fits.json").write_text(json.dumps({"points": 6, "finished": 6, "groups": []}))
