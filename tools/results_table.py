@@ -528,27 +528,31 @@ def local_exponents(rows):
 def bulk_table(done):
     """Per J over the windows the fits used: D from every particle's MSD and D_bulk from the MSD
     of those in the bulk band alone (observables.wall_exclusion, 3 d by default, inside each
-    wall line), each the mean over seeds +- the seeds' scatter over sqrt(n) (D_bulk has no error
-    bar of its own), and their ratio per run. Whether the spheres next to the walls set how D
-    changes with J: the bulk's D would then change otherwise."""
+    wall line), each the mean over seeds +- the seeds' scatter over sqrt(n), and their ratio per
+    run. D_bulk has no error bar of its own; the last column is one the size of the runs' own D
+    bars, each scaled by its run's D_bulk / D, rms over sqrt(n). Whether the spheres next to the
+    walls set how D changes with J: the bulk's D would then change otherwise."""
     print("| J | seeds | D / (gammadot d^2), every particle | D_bulk, the bulk band's | "
-          "D_bulk / D |")
-    print("|---|---|---|---|---|")
+          "D_bulk / D | D_bulk's error from the runs' D bars |")
+    print("|---|---|---|---|---|---|")
     by_j = runs_by_j(done)
     for J in sorted(j for j in by_j if j is not None):
-        pairs = np.array([(cell(r, "D"), cell(r, "D_bulk")) for r in by_j[J]
-                          if cell(r, "D") is not None and cell(r, "D_bulk") is not None])
-        if len(pairs) == 0:
+        runs = [r for r in by_j[J] if cell(r, "D") is not None and cell(r, "D_bulk") is not None]
+        if not runs:
             continue
-        n = len(pairs)
-        ratio = pairs[:, 1] / pairs[:, 0]
+        n = len(runs)
+        d = np.array([cell(r, "D") for r in runs])
+        bulk = np.array([cell(r, "D_bulk") for r in runs])
+        ratio = bulk / d
 
         def sem(x):
             return float(np.std(x, ddof=1) / math.sqrt(n)) if n > 1 else None
 
-        print(f"| {J:g} | {n} | {pm(pairs[:, 0].mean(), sem(pairs[:, 0]))} | "
-              f"{pm(pairs[:, 1].mean(), sem(pairs[:, 1]))} | "
-              f"{pm(ratio.mean(), sem(ratio))} |")
+        errs = [cell(r, "D_err") for r in runs]
+        scaled = (float(np.sqrt(np.mean((np.array(errs) * ratio) ** 2)) / math.sqrt(n))
+                  if None not in errs else None)
+        print(f"| {J:g} | {n} | {pm(d.mean(), sem(d))} | {pm(bulk.mean(), sem(bulk))} | "
+              f"{pm(ratio.mean(), sem(ratio))} | {fmt(scaled, 2)} |")
 
 
 ERROR_CHECKED = (("phi", "phi"), ("mu", "mu"), ("D", "D / (gammadot d^2)"),
