@@ -16,6 +16,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "sheardiff/config.hpp"
 #include "sheardiff/core/text.hpp"
@@ -205,14 +206,17 @@ class WorkerPool {
 
 // States first (a foreign directory stops the sweep before anything starts), longest first.
 void WorkerPool::sort_points() {
+  std::set<const SweepPoint*> part_run;
   for (const auto& p : points_) {
-    if (point_state(spec_, p, out_dir_) == PointState::finished) {
+    const PointState state = point_state(spec_, p, out_dir_);
+    if (state == PointState::finished) {
       ++finished_before_;
       forget_failure(p);  // a failure recorded by an earlier attempt no longer describes it
     } else if (locked_elsewhere(point_lock(out_dir_, p))) {
       elsewhere_.push_back(&p);
     } else {
       todo_.push_back(&p);
+      if (state == PointState::resumable) part_run.insert(&p);
     }
   }
   // Workers of an earlier pool that was killed (SIGKILL, a lost terminal) still run their
@@ -222,8 +226,12 @@ void WorkerPool::sort_points() {
                "sweep: {} point(s) are being run by other processes (the workers of an earlier "
                "sweep whose pool was stopped?): waiting for them, not starting them again\n",
                elsewhere_.size());
-  std::stable_sort(todo_.begin(), todo_.end(),
-                   [](const SweepPoint* a, const SweepPoint* b) { return a->cost > b->cost; });
+  // Part-run points first, so that a sweep started again finishes what it had begun (their
+  // results land, their checkpoints go) before it begins more; then the costliest first.
+  std::stable_sort(todo_.begin(), todo_.end(), [&](const SweepPoint* a, const SweepPoint* b) {
+    const bool ra = part_run.contains(a), rb = part_run.contains(b);
+    return ra != rb ? ra : a->cost > b->cost;
+  });
   std::reverse(todo_.begin(), todo_.end());  // taken from the back
 }
 

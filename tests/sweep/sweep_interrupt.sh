@@ -93,4 +93,23 @@ echo "an earlier failure" > "out2/logs/$first_point.failed"
 "$bin" sweep tiny.toml --out out2 > again.log 2>&1
 [ -e "out2/logs/$first_point.failed" ] && { echo "a stale failure marker of a finished point stayed"; exit 1; }
 
+# A sweep started again resumes its part-run points before it begins fresh ones, whatever their
+# cost: J = 0.1, the cheaper of two points, is stopped after its first checkpoint, and the sweep
+# (one worker) must finish it before it begins J = 0.01.
+sed 's/"flow.J" = \[0.1, 0.05, 0.02, 0.01\]/"flow.J" = [0.1, 0.01]/' tiny.toml > two.toml
+grep -q '"flow.J" = \[0.1, 0.01\]' two.toml
+for _ in 1 2 3 4 5; do  # a run that finishes before the stop lands is tried again
+  rm -rf out3
+  "$bin" sweep two.toml --out out3 --point 0 > part.log 2>&1 &
+  pid=$!
+  for _ in $(seq 500); do [ -e out3/points/J=0.1/checkpoint.bin ] && break; sleep 0.01; done
+  kill -TERM "$pid" 2> /dev/null || true
+  wait "$pid" 2> /dev/null || true
+  [ -e out3/points/J=0.1/checkpoint.bin ] && [ ! -e out3/points/J=0.1/summary.json ] && break
+done
+[ -e out3/points/J=0.1/checkpoint.bin ] || { echo "J=0.1 was not stopped part-way"; cat part.log; exit 1; }
+"$bin" sweep two.toml --out out3 --jobs 1 > order.log 2>&1
+[ out3/points/J=0.1/summary.json -ot out3/points/J=0.01/summary.json ] ||
+  { echo "the fresh J=0.01 was begun before the part-run J=0.1"; cat order.log; exit 1; }
+
 echo "sweep_interrupt: killed after $(echo "$finished" | wc -w) finished point(s); resumed to 4/4 with them untouched"
