@@ -159,8 +159,8 @@ class BlockedSignals {
   sigset_t set_{}, old_{};
 };
 
-// The pool of one `sweep` command: points to run (longest first), points that workers of an
-// earlier pool still run, the workers it started, and what it has counted.
+// The pool of one `sweep` command: points to run (part-run first, then longest first), points
+// that workers of an earlier pool still run, the workers it started, and what it has counted.
 class WorkerPool {
  public:
   WorkerPool(const SweepSpec& spec, const fs::path& out_dir, int jobs, const fs::path& exe,
@@ -204,7 +204,8 @@ class WorkerPool {
   int stop_signal_ = 0;
 };
 
-// States first (a foreign directory stops the sweep before anything starts), longest first.
+// States first (a foreign directory stops the sweep before anything starts); part-run points
+// first, then the longest.
 void WorkerPool::sort_points() {
   std::set<const SweepPoint*> part_run;
   for (const auto& p : points_) {
@@ -321,16 +322,19 @@ void WorkerPool::progress() {
 }
 
 // A point run elsewhere is checked at each tick: once its lock is free it is finished (done)
-// or goes back to the queue (it resumes from its checkpoint).
+// or goes back to the queue: next if it has a checkpoint to resume from, else last.
 void WorkerPool::poll_elsewhere() {
   for (auto it = elsewhere_.begin(); it != elsewhere_.end();) {
     if (locked_elsewhere(point_lock(out_dir_, **it))) {
       ++it;
       continue;
     }
-    if (point_state(spec_, **it, out_dir_) == PointState::finished) {
+    const PointState state = point_state(spec_, **it, out_dir_);
+    if (state == PointState::finished) {
       ++finished_before_;
       forget_failure(**it);
+    } else if (state == PointState::resumable) {
+      todo_.push_back(*it);
     } else {
       todo_.insert(todo_.begin(), *it);
     }
