@@ -14,18 +14,21 @@ Per frame: ITEM: TIMESTEP (the run's step), the atoms' count, a triclinic box wh
 the frame's Lees-Edwards shift (the reduced tilt of the trajectory's edges), and per atom
 `id type x y z xu yu zu ix iy iz vx vy vz diameter`: positions, images and velocities exactly as
 the trajectory holds them (their shortest exact decimal text), and the unwrapped position
-xu = x + ix Lx + iy xy, yu = y + iy Ly, continuous in time (docs/trajectory.md, "Images").
+xu = x + ix Lx + iy xy, yu = y + iy Ly, zu = z + iz Lz, continuous in time (docs/trajectory.md,
+"Positions, image and unwrapped positions").
 MDAnalysis reads x y z by default and xu yu zu with lammps_coordinate_convention="unwrapped";
 its own unwrap_images=True ignores the tilt (MDAnalysis 2.4 adds image x box length), so use the
 xu columns in a sheared box. The box is the trajectory's: its lower corner
 at the origin (MDAnalysis measures positions from that corner, so what it reads equals what
-h5py reads), the edges Lx, Ly and the tilt xy of the frame. The third dimension is padding, as
-in LAMMPS's own 2D dumps: z = 0 and a z extent of one diameter, [0, 1]. Types: 1 small, 2 large,
+h5py reads), the edges Lx, Ly (and Lz for spheres) and the tilt xy of the frame. A run of spheres
+(scene.dimension = 3) is periodic in z with its own Lz; for discs the third dimension is padding,
+as in LAMMPS's own 2D dumps: z = 0, iz = 0 and a z extent of one diameter, [0, 1]. Types: 1 small, 2 large,
 3 fixed_wall, 4 floating_wall, 5 driven_wall. The pressure cell is not periodic in y: its y
 boundary is LAMMPS's fixed one (`pp ff pp`), and, as in the trajectory, its y edge is the
-packing's height H, from which the wall particles stick out. Lengths are in d and times in
-1/gammadot (the channel: a and a/<u>; docs/units.md), as LAMMPS's `units lj` leaves them: the
-file states no unit (MDAnalysis will call them Angstrom and ps).
+packing's height H, from which the wall particles stick out. Lengths are in d and velocities in
+P d / eta, as stored (divide by J for gammadot d; the channel: a and <u>; docs/units.md), as
+LAMMPS's `units lj` leaves them: the file states no unit (MDAnalysis will call them Angstrom and
+Angstrom/ps).
 """
 import argparse
 import gzip
@@ -46,28 +49,33 @@ def type_ids(species, motion):
 
 def write_frame(out, t, k, types):
     pos, img = t["position"][k], t["image"][k]
-    n = pos.shape[0]
-    lx, xy, ly = (float(t["edges"][k, 0, 0]), float(t["edges"][k, 1, 0]), float(t["edges"][k, 1, 1]))
+    n, dim = pos.shape
+    e = t["edges"][k]
+    lx, xy, ly = float(e[0, 0]), float(e[1, 0]), float(e[1, 1])
+    lz = float(e[2, 2]) if dim == 3 else 1.0
     # LAMMPS stores a tilted box by the bounds of its bounding box (the dump command's rule).
     out.write(f"ITEM: TIMESTEP\n{int(t['step'][k])}\nITEM: NUMBER OF ATOMS\n{n}\n")
     out.write(f"ITEM: BOX BOUNDS xy xz yz pp {'pp' if t['periodic_y'] else 'ff'} pp\n")
-    out.write(f"{min(0.0, xy)!r} {lx + max(0.0, xy)!r} {xy!r}\n0.0 {ly!r} 0.0\n0.0 1.0 0.0\n")
+    out.write(f"{min(0.0, xy)!r} {lx + max(0.0, xy)!r} {xy!r}\n0.0 {ly!r} 0.0\n0.0 {lz!r} 0.0\n")
     out.write("ITEM: ATOMS id type x y z xu yu zu ix iy iz vx vy vz diameter\n")
-    vel = t["velocity"][k] if t["velocity"] is not None else np.zeros((n, 2))
+    vel = t["velocity"][k] if t["velocity"] is not None else np.zeros((n, dim))
     # LAMMPS's unwrapped position: the image's box vectors added, the tilt included.
     xu = pos[:, 0] + img[:, 0] * lx + img[:, 1] * xy
     yu = pos[:, 1] + img[:, 1] * ly
     text = lambda values: [repr(float(v)) for v in values]  # noqa: E731
-    columns = [range(1, n + 1), types, text(pos[:, 0]), text(pos[:, 1]), ["0.0"] * n, text(xu), text(yu),
-               ["0.0"] * n, img[:, 0], img[:, 1], [0] * n, text(vel[:, 0]), text(vel[:, 1]), ["0.0"] * n,
-               text(t["diameter"])]
+    if dim == 3:
+        z, zu, iz, vz = text(pos[:, 2]), text(pos[:, 2] + img[:, 2] * lz), img[:, 2], text(vel[:, 2])
+    else:
+        z, zu, iz, vz = ["0.0"] * n, ["0.0"] * n, [0] * n, ["0.0"] * n
+    columns = [range(1, n + 1), types, text(pos[:, 0]), text(pos[:, 1]), z, text(xu), text(yu), zu,
+               img[:, 0], img[:, 1], iz, text(vel[:, 0]), text(vel[:, 1]), vz, text(t["diameter"])]
     out.write("\n".join(" ".join(str(c) for c in row) for row in zip(*columns)) + "\n")
 
 
 def export(h5_path, out_path, every=1):
     t = rundir.read_trajectory(h5_path)
-    if t["position"].shape[2] != 2:
-        raise SystemExit(f"h5md_to_lammps: {h5_path} is not a 2D trajectory")
+    if t["position"].shape[2] not in (2, 3):
+        raise SystemExit(f"h5md_to_lammps: {h5_path} has positions of {t['position'].shape[2]} components")
     types = type_ids(t["species"], t["motion"])
     frames = range(0, t["position"].shape[0], every)
     opener = gzip.open if str(out_path).endswith(".gz") else open

@@ -191,8 +191,9 @@ def unwrapped_positions(group, frames=slice(None)):
 
 def read_trajectory(path):
     """The whole trajectory of an H5MD file (a run's trajectory.h5, finished or running) as numpy
-    arrays, for the exporters: position, image (frames x N x 2), velocity (or None), edges (frames
-    x 2 x 2: rows are the box vectors, the Lees-Edwards tilt in edges[:, 1, 0]), periodic_y,
+    arrays, for the exporters: position, image (frames x N x dimension), velocity (or None),
+    edges (frames x dimension x dimension: rows are the box vectors, the Lees-Edwards tilt in
+    edges[:, 1, 0]), periodic_y,
     diameter, species, motion (N), step, time (frames) and the scalar observables by name."""
     import h5py
     import numpy as np

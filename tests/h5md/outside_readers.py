@@ -20,7 +20,8 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
    position + image . edges;
 7. a run of spheres (scene.dimension = 3): the H5MD checker passes on its 3D layout, and its GSD
    export is a 3D box (Lx, Ly, Lz) with every sphere inside it and position + image . box
-   continuous in time over its x crossings.
+   continuous in time over its x crossings; MDAnalysis reads its LAMMPS dump export as in 5,
+   z and its image counts included.
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -291,7 +292,8 @@ def check_mdanalysis(root, traj, periodic_y):
     (tools/h5md_to_lammps.py): every frame's positions equal h5py's (to float32, MDAnalysis's
     precision), its box vectors the H5MD edges (tilt included), its velocities h5py's, and with
     lammps_coordinate_convention="unwrapped" the positions equal position + image . edges and
-    are continuous over the run's Lees-Edwards crossings."""
+    are continuous over the run's Lees-Edwards crossings. Discs have z = 0; spheres their own z,
+    and a z edge of the H5MD Lz."""
     import warnings
 
     warnings.simplefilter("ignore")  # MDAnalysis guesses masses, Python 3.11 deprecations
@@ -304,18 +306,24 @@ def check_mdanalysis(root, traj, periodic_y):
         g = f["particles/suspension"]
         pos, vel = g["position/value"][()], g["velocity/value"][()]
         img, edges = g["image/value"][()].astype(np.float64), g["box/edges/value"][()]
-    unw = pos + img[:, :, :1] * edges[:, None, 0, :] + img[:, :, 1:] * edges[:, None, 1, :]
+    dim = pos.shape[2]
+    unw = pos + np.einsum("fnk,fkc->fnc", img, edges)
     name = traj.parent.name
     for convention, want in (("auto", pos), ("unwrapped", unw)):
         u = mda.Universe(str(out), format="LAMMPSDUMP", lammps_coordinate_convention=convention)
         expect(len(u.trajectory) == len(pos), f"{name}: MDAnalysis reads {len(pos)} frames ({len(u.trajectory)})")
         worst_pos = worst_box = worst_vel = 0.0
         for k, ts in enumerate(u.trajectory):
-            worst_pos = max(worst_pos, np.abs(ts.positions[:, :2] - want[k].astype(np.float32)).max(),
-                            np.abs(ts.positions[:, 2]).max())
-            worst_vel = max(worst_vel, np.abs(ts.velocities[:, :2] - vel[k].astype(np.float32)).max())
-            worst_box = max(worst_box, np.abs(ts.triclinic_dimensions[:2, :2] - edges[k]).max()
-                            if periodic_y else abs(ts.triclinic_dimensions[0, 0] - edges[k, 0, 0]))
+            worst_pos = max(worst_pos, np.abs(ts.positions[:, :dim] - want[k].astype(np.float32)).max(),
+                            np.abs(ts.positions[:, dim:]).max(initial=0.0))
+            worst_vel = max(worst_vel, np.abs(ts.velocities[:, :dim] - vel[k].astype(np.float32)).max(),
+                            np.abs(ts.velocities[:, dim:]).max(initial=0.0))
+            box = ts.triclinic_dimensions
+            # The pressure cell's y edge is the packing's height, not the box's: x (and z) only.
+            compared = [0, 1] if periodic_y else [0]
+            if dim == 3:
+                worst_box = max(worst_box, np.abs(box[2] - edges[k, 2]).max(), np.abs(box[:2, 2]).max())
+            worst_box = max(worst_box, np.abs(box[np.ix_(compared, [0, 1])] - edges[k][np.ix_(compared, [0, 1])]).max())
         expect(worst_pos == 0.0, f"{name} ({convention}): MDAnalysis's positions are h5py's as float32 "
                                  f"(largest difference {worst_pos:.3g})")
         expect(worst_vel == 0.0, f"{name}: MDAnalysis's velocities are h5py's as float32 ({worst_vel:.3g})")
@@ -499,6 +507,7 @@ def main():
     else:
         check_mdanalysis(args.root, long, True)
         check_mdanalysis(args.root, pressure, False)
+        check_mdanalysis(args.root, spheres, False)
     check_plot_tools(args.root, args.work, (simple.parent, pressure.parent))
     check_live_reading(args.bin, args.root, args.work)
     print(f"{len(failures)} failed")
