@@ -21,7 +21,8 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
 7. a run of spheres (scene.dimension = 3): the H5MD checker passes on its 3D layout, and its GSD
    export is a 3D box (Lx, Ly, Lz) with every sphere inside it and position + image . box
    continuous in time over its x crossings; MDAnalysis reads its LAMMPS dump export as in 5,
-   z and its image counts included.
+   z and its image counts included; snapshot.py's sections by planes z = Z hold the spheres'
+   volume (Delesse's rule).
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -467,6 +468,34 @@ def check_gsd_spheres(root, traj):
            f"between frames {jump:.3g} d)")
 
 
+def check_snapshot_spheres(root, traj):
+    """snapshot.py draws a run of spheres as its section by a plane z = Z. Delesse's rule checks
+    the sections: over planes spread evenly across the box, the mean area of the cut circles is
+    the spheres' volume over Lz (exactly, for the integral; 400 planes put the midpoint rule
+    within ~1e-5 here), which fails if an image across the z edge is missed (spheres within a of
+    the edge lose their cut) or a cut has the sphere's radius (x 1.5)."""
+    sys.path.insert(0, str(root / "tools"))
+    import snapshot
+
+    with h5py.File(traj, "r") as f:
+        g = f["particles/suspension"]
+        z, diam = g["position/value"][-1][:, 2], g["diameter"][()]
+        lz = float(g["box/edges/value"][-1][2, 2])
+    planes = (np.arange(400) + 0.5) * lz / 400
+    area = np.mean([np.sum(np.pi * snapshot.section(z, diam, lz, z0)[1] ** 2) for z0 in planes])
+    volume = np.sum(np.pi * diam ** 3 / 6) / lz
+    expect(abs(area / volume - 1) < 1e-3, f"spheres: snapshot.py's sections hold the spheres' volume "
+                                          f"(mean section area over Lz's, relative {area / volume - 1:.2g})")
+    out = traj.parent / "snapshot.png"
+    p = subprocess.run([sys.executable, str(root / "tools" / "snapshot.py"), str(traj.parent), "--z", "0"],
+                       capture_output=True, text=True)
+    expect(p.returncode == 0 and out.stat().st_size > 0, f"spheres: snapshot.py draws a section ({p.stderr.strip()})")
+    p = subprocess.run([sys.executable, str(root / "tools" / "snapshot.py"), str(traj.parent), "--z", str(2 * lz)],
+                       capture_output=True, text=True)
+    expect(p.returncode != 0 and "--z must lie in" in p.stderr,
+           f"spheres: snapshot.py refuses a section outside the box ({p.stderr.strip()})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -498,6 +527,7 @@ def main():
     check_conformance(spheres, args.work)
     if "gsd" in sys.modules:
         check_gsd_spheres(args.root, spheres)
+    check_snapshot_spheres(args.root, spheres)
     long = run(args.bin, args.work, "simple_shear_long", LONG)
     check_continuity(args.root, long)
     try:
