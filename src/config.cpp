@@ -489,8 +489,7 @@ void apply_table(Config& cfg, const toml::table& root, const std::string& origin
   }
 }
 
-// Spheres: a scene that has them, placed by its own builder, written without the contact
-// network.
+// Spheres: a scene that has them, placed by its own builder.
 void check_spheres(const Config& c, const std::string& origin) {
   if (c.scene.dimension != 3) return;
   if (!scene_kind(c.scene.type).spheres)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """ctest: no include runs against the data flow between the folders of include/sheardiff/ and
-src/ (README, "Layout"): the state and the configuration first, then scene set-up, neighbour
+src/ (README, "The source, in the order a run uses it"): the state and the configuration first, then scene set-up, neighbour
 list, interactions, solver, integrator, observers, and what composes a run on top. A file may
 include its own folder and any folder before it, never one after it. A parameters header
 (NAME_params.hpp: one unit's configuration keys, declared by the unit that owns them) includes
