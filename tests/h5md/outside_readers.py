@@ -22,7 +22,9 @@ Runs a small simple-shear and a small pressure-cell run (contact network on), th
    export is a 3D box (Lx, Ly, Lz) with every sphere inside it and position + image . box
    continuous in time over its x crossings; MDAnalysis reads its LAMMPS dump export as in 5,
    z and its image counts included; snapshot.py's sections by planes z = Z hold the spheres'
-   volume (Delesse's rule).
+   volume (Delesse's rule);
+8. centre_of_mass_drift.py's drag of the recorded velocities equals the walls' load difference
+   (net_drag_y) frame by frame, for discs and for spheres.
 
     outside_readers.py --bin build/sheardiff --root . --work DIR
 """
@@ -496,6 +498,21 @@ def check_snapshot_spheres(root, traj):
            f"spheres: snapshot.py refuses a section outside the box ({p.stderr.strip()})")
 
 
+def check_drift(root, traj):
+    """tools/centre_of_mass_drift.py: the Stokes drag of the recorded velocities over the walls'
+    area (Lx lz for discs, Lx Lz for spheres) is, frame by frame, what the walls' load
+    difference (net_drag_y) balances: equal to round-off."""
+    sys.path.insert(0, str(root / "tools"))
+    import centre_of_mass_drift
+
+    r = centre_of_mass_drift.drift(traj.parent, every=1)
+    gap = np.abs(r["implied_by_frame"] - r["drag_by_frame"]).max()
+    scale = np.abs(r["drag_by_frame"]).max()
+    expect(scale > 0 and gap < 1e-9 * scale,
+           f"{traj.parent.name}: centre_of_mass_drift.py's implied drag is net_drag_y in every frame "
+           f"(largest difference {gap:.2g} P of {scale:.2g})")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--bin", required=True)
@@ -528,6 +545,8 @@ def main():
     if "gsd" in sys.modules:
         check_gsd_spheres(args.root, spheres)
     check_snapshot_spheres(args.root, spheres)
+    for traj in (pressure, spheres):
+        check_drift(args.root, traj)
     long = run(args.bin, args.work, "simple_shear_long", LONG)
     check_continuity(args.root, long)
     try:
