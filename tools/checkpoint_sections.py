@@ -14,16 +14,19 @@ import re
 import struct
 import sys
 
-# A tag: its name's length as a little-endian 64-bit integer, then the name.
-TAG = re.compile(rb"([\x04-\x28])\x00{7}([a-z_]{4,40})")
+# A tag: its name's length as a little-endian 64-bit integer (4 to 40), then exactly that many
+# bytes of name. The name is read by its length, not by the letters that follow: the section's
+# first byte may itself be a lowercase letter.
+LENGTH = re.compile(rb"(?=([\x04-\x28])\x00{7})")
+NAME = re.compile(rb"[a-z_]+")
 
 
 def sections(data):
     found = []
-    for m in TAG.finditer(data):
+    for m in LENGTH.finditer(data):
         (length,) = struct.unpack("<Q", data[m.start():m.start() + 8])
-        name = m.group(2)
-        if length == len(name):
+        name = data[m.start() + 8:m.start() + 8 + length]
+        if len(name) == length and NAME.fullmatch(name):
             found.append((m.start(), name.decode()))
     return found
 

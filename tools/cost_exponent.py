@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Fitted exponent b of cost = a N^b for every benchmark family of bench_step's JSON output
-(the default frictional variant at N = 250, 1000, 4000), least squares in log-log space.
+(the default frictional variant at N = 250, 1000, 4000) or of bench_step_3d's (spheres at
+N = 500, 1000, 2000; its benchmarks carry no variant label), least squares in log-log space.
 
     OMP_THREAD_LIMIT=1 build/bench/bench_step --benchmark_format=json > step.json
     /usr/bin/python3 tools/cost_exponent.py step.json
@@ -13,12 +14,18 @@ import numpy as np
 
 def main(path):
     data = json.load(open(path))
+    runs = [b for b in data.get("benchmarks", []) if b.get("run_type") != "aggregate" and "N" in b]
+    # bench_step labels its variants (the frictional one is fitted); bench_step_3d has one variant.
+    labelled = any(b.get("label") for b in runs)
     fams = {}
-    for b in data["benchmarks"]:
-        if b.get("run_type") == "aggregate" or b.get("label") != "frictional":
+    for b in runs:
+        if labelled and b.get("label") != "frictional":
             continue
         name = b["name"].split("/")[0]
         fams.setdefault(name, []).append((b["N"], b["real_time"], b.get("cpu_time", b["real_time"])))
+    if not fams:
+        sys.exit(f"cost_exponent: {path} holds no benchmark with an N counter "
+                 "(give bench_step's or bench_step_3d's --benchmark_format=json output)")
     print(f"{'benchmark':24s} " + " ".join(f"{'N=' + str(int(n)):>10s}" for n, _, _ in
                                            sorted(next(iter(fams.values())))) + "   exponent (cpu)")
     for name, pts in fams.items():

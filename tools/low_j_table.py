@@ -5,7 +5,8 @@ usage: tools/low_j_table.py RUNDIR[:FROM_STRAIN] ...   (FROM_STRAIN defaults to 
 
 Averages over the recorded frames with strain >= FROM_STRAIN (also over each half of that
 window, a drift check): bulk phi, mu = (mu_top + mu_bottom)/2, the particle-averaged spread of
-omega/gammadot and v_y/gammadot, and the mean omega/gammadot (the fluid's is -1/2). Works on a
+omega/gammadot and v_y/gammadot, and the mean omega/gammadot (the fluid's is -1/2; for spheres
+omega is the spin about z, the axis of the flow's vorticity). Works on a
 run stopped by a signal (no summary.json) as long as its trajectory is closed.
 """
 import os, sys
@@ -29,6 +30,8 @@ for arg in sys.argv[1:]:
         p = f['particles/suspension']
         mobile = p['motion'][:] == 0
         w = p['angular_velocity/value'][:][:, mobile] / J
+        if w.ndim == 3:  # spheres: the spin about z, the axis of the imposed flow's vorticity
+            w = w[:, :, 2]
         vy = p['velocity/value'][:][:, mobile, 1] / J
     idx = np.where(sel)[0]
     a, b = idx[: len(idx) // 2], idx[len(idx) // 2:]

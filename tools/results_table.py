@@ -241,8 +241,10 @@ def means_table(rows):
 
 
 def law_table(f, seed, dimension=2):
-    """The fitted laws of one group against the seed's Table 1, with verdicts."""
-    print("| law | sheardiff: a, b (seed-bootstrap errors) | seed Table 1: a, b | a | b |")
+    """The fitted laws of one group against the seed's Table 1 (spheres' phi: Boyer et al.), with
+    verdicts."""
+    ref = "seed Table 1 (phi: Boyer et al.): a, b" if dimension == 3 else "seed Table 1: a, b"
+    print(f"| law | sheardiff: a, b (seed-bootstrap errors) | {ref} | a | b |")
     print("|---|---|---|---|---|")
     for key, name in (("D_vs_J", "D/(gammadot d^2) = a J^b"),
                       ("dv_vs_J", "dv/(gammadot d) = a J^b"),
@@ -262,10 +264,15 @@ def law_table(f, seed, dimension=2):
         cp = CLOSE_PACKING[dimension]
         warn = (f" (above the {dimension}D close packing {cp}: unphysical)" if p["phi_c"] > cp
                 else "")
+        # Spheres have no law of the seed's: their reference is Boyer et al.'s phi_m / (1 + J^1/2),
+        # which tends to phi_m (1 - J^1/2) as J -> 0 (phi_c = phi_m, b = 1/2; no error given).
+        ref, ref_phi_c, ref_err = (("Boyer et al. (J -> 0): phi_c = phi_m = 0.585, a = 0.585, b = 0.5",
+                                    0.585, 0.0) if dimension == 3
+                                   else ("phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5", 0.81, 0.01))
         print(f"| phi = phi_c - a J^b | phi_c = {phi_c}"
               f"{warn}, a = {pm(p['a'], p.get('a_stderr'))}, b = {pm(p['b'], p.get('b_stderr'))} "
-              f"| phi_c = 0.81 +- 0.01, a = 0.64, b = 0.5 | phi_c: "
-              f"{verdict(p['phi_c'], p.get('phi_c_stderr'), 0.81, 0.01)} | "
+              f"| {ref} | phi_c: "
+              f"{verdict(p['phi_c'], p.get('phi_c_stderr'), ref_phi_c, ref_err)} | "
               f"{verdict(p['b'], p.get('b_stderr'), 0.5, 0.0)} |")
     m = f["mu_of_J"]
     if "mu_c" in m:
@@ -643,7 +650,7 @@ def causes(done):
     if not any(r.get("D_bulk") for r in done):
         return
     print("#### Diagnostics of the candidate causes (per J: mean over seeds +- sem)\n")
-    print("(b) bulk only / all discs; (c) shear rate of the bulk over V/H and mu_top - mu_bottom; "
+    print("(b) bulk only / all the mobile particles; (c) shear rate of the bulk over V/H and mu_top - mu_bottom; "
           "(e) D / (dv^2 Psi) for each definition of Psi.\n")
     print("| J | D_bulk / D | dv_bulk / dv | Psi_bulk / Psi | bulk shear rate / (V/H) | "
           "mu_top - mu_bottom | D/(dv^2 psi) | D/(dv^2 psi_e) | D/(dv^2 psi_full) | "

@@ -9,7 +9,10 @@ a step does (solves, assembly, neighbour search, observers), so a real run costs
     /usr/bin/python3 tools/sweep_cost.py STORE_OR_SWEEP_DIR... [--strains 33]
         [--ms-per-factorisation 2.3] [--only N=1000]
 
-Each directory is a results store or a sweep folder (its points/*/summary.json are read)."""
+Each directory is a results store or a sweep folder (its points/*/summary.json are read). One
+table prices one kind of factorisation: points of discs and of spheres are not mixed (--only
+dimension=2 or 3), and for spheres --ms-per-factorisation must be given (their factorisation
+costs ~25-35 times the discs' at N = 1000: bench_solver's cholmod_spheres)."""
 import argparse
 import sys
 
@@ -21,18 +24,19 @@ def main():
     ap.add_argument("dirs", nargs="+")
     ap.add_argument("--strains", type=float, default=33.0,
                     help="strains per point, transient included (the seed's protocol: 3 + 30)")
-    ap.add_argument("--ms-per-factorisation", type=float, default=2.3,
-                    help="CPU ms of one factorisation (bench_solver; 2.3 at N = 1000 here)")
+    ap.add_argument("--ms-per-factorisation", type=float,
+                    help="CPU ms of one factorisation (bench_solver; discs: 2.3 at N = 1000 by default; "
+                         "spheres: required)")
     ap.add_argument("--only", action="append", default=[], metavar="KEY=VALUE",
-                    help="keep the summaries whose KEY (N, ktilde, J, scene) equals VALUE")
+                    help="keep the summaries whose KEY (N, ktilde, J, scene, dimension) equals VALUE")
     a = ap.parse_args()
-    if a.strains <= 0 or a.ms_per_factorisation <= 0:
+    if a.strains <= 0 or (a.ms_per_factorisation is not None and a.ms_per_factorisation <= 0):
         sys.exit("--strains and --ms-per-factorisation must be > 0")
     only = []
     for cond in a.only:
         key, eq, value = cond.partition("=")
-        if not eq or key not in ("N", "ktilde", "J", "scene"):
-            sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of N, ktilde, J, scene")
+        if not eq or key not in ("N", "ktilde", "J", "scene", "dimension"):
+            sys.exit(f"--only {cond}: give KEY=VALUE with KEY one of N, ktilde, J, scene, dimension")
         if key != "scene":
             try:
                 value = float(value)
@@ -47,15 +51,25 @@ def main():
         for s in (p.summary for p in points):
             if not s.get("steps") or "factorisations" not in s:
                 continue  # a summary from before the solver's counters
+            s = dict(s, dimension=s.get("dimension", 2))  # summaries of discs before the key
             if any(s.get(k) != v if k == "scene" else float(s.get(k, "nan")) != v
                    for k, v in only):
                 continue
             key = (s["scene"], s["N"], s["ktilde"], s["J"])
-            groups.setdefault(key, []).append(s)
+            groups.setdefault(s["dimension"], {}).setdefault(key, []).append(s)
     if not groups:
         sys.exit("no summary with steps and factorisations matched")
-    print(f"floor = factorisations per strain x {a.ms_per_factorisation:g} ms; "
-          f"per point: {a.strains:g} strains\n")
+    if len(groups) > 1:
+        sys.exit("the points hold discs and spheres, whose factorisations cost different times: "
+                 "price one kind per table (--only dimension=2 or --only dimension=3)")
+    dimension, groups = next(iter(groups.items()))
+    if a.ms_per_factorisation is None:
+        if dimension == 3:
+            sys.exit("spheres: give --ms-per-factorisation, measured on this machine (bench_solver's "
+                     "cholmod_spheres; the discs' default of 2.3 ms is ~25-35 times too small)")
+        a.ms_per_factorisation = 2.3
+    print(f"{'spheres' if dimension == 3 else 'discs'}: floor = factorisations per strain x "
+          f"{a.ms_per_factorisation:g} ms; per point: {a.strains:g} strains\n")
     print("| scene | N | ktilde | J | points | steps / strain | factorisations / step "
           "| floor CPU s / strain | floor CPU h / point |")
     print("|---|---|---|---|---|---|---|---|---|")

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """tools/results_table.py on a synthetic store with a known answer: one J-sweep group whose
 J = 1e-3 row lies 0.01 above the seed's phi law and at 1.5x its D law, 1x its dv and Psi laws;
-the per-J table must read those (+0.0100, 1.50, 1.00), and a store without J fits (channel cases
-over seeds) must be refused with a reason. Usage: results_table_test.py REPO WORK"""
+the per-J table must read those (+0.0100, 1.50, 1.00); a store of spheres has its phi law set
+against Boyer et al.'s; and a store without J fits (channel cases over seeds) must be refused
+with a reason. Usage: results_table_test.py REPO WORK"""
 import csv
 import json
 import pathlib
@@ -56,6 +57,25 @@ assert cells[4].startswith("0.24 ") and "b = 0.5 " in cells[5], full
 only = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--ranges",
                        str(work)], capture_output=True, text=True, check=True).stdout
 assert only.splitlines()[0].startswith("| J range |") and full in only.splitlines(), only
+# Spheres (sweep.csv's dimension = 3): their phi law is set against Boyer et al.'s J -> 0 form,
+# phi_m (1 - J^1/2) with phi_m = 0.585, not against the discs' phi_c = 0.81; phi_c = 0.590 +- 0.005
+# is 1.0 standard error from it (44 from 0.81).
+spheres = work / "spheres"
+spheres.mkdir(exist_ok=True)
+sphere_fits = json.loads((work / "fits.json").read_text())
+sphere_fits["groups"][0]["fits"]["phi_of_J"] = {"phi_c": 0.590, "phi_c_stderr": 0.005, "a": 0.5,
+                                                "a_stderr": 0.01, "b": 0.5, "b_stderr": 0.01}
+(spheres / "fits.json").write_text(json.dumps(sphere_fits))
+with open(work / "sweep.csv") as src, open(spheres / "sweep.csv", "w", newline="") as dst:
+    rows = list(csv.DictReader(src))
+    w = csv.DictWriter(dst, fieldnames=list(rows[0]) + ["dimension"])
+    w.writeheader()
+    for r in rows:
+        w.writerow(dict(r, dimension=3))
+out = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--laws", str(spheres)],
+                     capture_output=True, text=True, check=True).stdout
+phi_row = next(l for l in out.splitlines() if l.startswith("| phi = phi_c"))
+assert "phi_m = 0.585" in phi_row and "phi_c: agrees (1.0 sigma)" in phi_row, phi_row
 # A store of channel cases: no J fits, refused with the reason.
 fits = {"points": 2, "finished": 2, "groups": []}
 (work / "fits.json").write_text(json.dumps(fits))
