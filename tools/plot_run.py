@@ -4,8 +4,9 @@ and, where RUN/analysis.h5 exists, the diffusion analysis.
 
     /usr/bin/python3 tools/plot_run.py RUN_DIR [--out RUN_DIR/timeseries.png]
 
-timeseries.png: the friction coefficient mu, the area fraction phi, the gap H and the pressure
-on the top wall (pressure cell; a simple-shear run has the particle pressure and no H) against
+timeseries.png: the friction coefficient mu, the solid fraction phi (area for discs, volume for
+spheres), the gap H and the pressure on the top wall (pressure cell; a simple-shear run has the
+particle pressure and no H) against
 strain, a running mean over about one strain, the measured window shaded (pressure cell: from
 summary.json's steady_detected_at, where the run's measurement starts; simple shear: after
 run.transient_strain) and the window's mean +- error in each panel. These are the run's own

@@ -6,7 +6,8 @@ results/velocity_definition_n250, from configs/sweep_velocity_definition_n250.to
 Markdown table: per J, dv and Psi from the instantaneous velocities and from displacements over
 each interval, as ratios to the seed's laws dv = 0.26 J^(-1/4) and Psi = 0.35 J^(1/4) (with the
 run's jackknife errors), and D / (dv^2 Psi) per definition. Then, per definition, whether both
-ratios are within 2 sigma of 1 at every J.
+ratios are within 2 sigma of 1 at every J. The seed's laws are the discs'; a store of spheres
+is set against them too, as the 2D reference, and the table's heading says so.
 
     tools/velocity_definition_table.py results/velocity_definition_n250 [--out FILE]
 """
@@ -36,7 +37,7 @@ def load(store):
             defs.append((f"Delta = {delta:g}", s["dv_intervals"][k], s["dv_intervals_err"][k],
                          s["psi_intervals"][k], s["psi_intervals_err"][k]))
         rows.append({"J": s["J"], "D": s["D"], "stationary": s.get("stationary"),
-                     "point": run.path.name, "defs": defs})
+                     "point": run.path.name, "defs": defs, "dimension": s.get("dimension", 2)})
     return sorted(rows, key=lambda r: r["J"])
 
 
@@ -83,6 +84,8 @@ def main():
     if not rows:
         sys.exit(f"{a.store}: no point with analysis.velocity_intervals")
     text = table(rows)
+    if any(r["dimension"] == 3 for r in rows):
+        text = "Spheres against the seed's laws of discs (the 2D reference):\n\n" + text
     sys.stdout.write(text)
     if a.out:
         pathlib.Path(a.out).write_text(text)
