@@ -2,6 +2,8 @@
 """Fitted exponent b of cost = a N^b for every benchmark family of bench_step's JSON output
 (the default frictional variant at N = 250, 1000, 4000) or of bench_step_3d's (spheres at
 N = 500, 1000, 2000; its benchmarks carry no variant label), least squares in log-log space.
+From output with repetitions aggregated only (--benchmark_report_aggregates_only) the medians
+are fitted.
 
     OMP_THREAD_LIMIT=1 build/bench/bench_step --benchmark_format=json > step.json
     /usr/bin/python3 tools/cost_exponent.py step.json
@@ -14,7 +16,12 @@ import numpy as np
 
 def main(path):
     data = json.load(open(path))
-    runs = [b for b in data.get("benchmarks", []) if b.get("run_type") != "aggregate" and "N" in b]
+    benchmarks = [b for b in data.get("benchmarks", []) if "N" in b]
+    runs = [b for b in benchmarks if b.get("run_type") != "aggregate"]
+    if not runs:  # --benchmark_report_aggregates_only: the medians of the repetitions
+        runs = [b for b in benchmarks if b.get("aggregate_name") == "median"]
+        for b in runs:
+            b["name"] = b["name"].removesuffix("_median")
     # bench_step labels its variants (the frictional one is fitted); bench_step_3d has one variant.
     labelled = any(b.get("label") for b in runs)
     fams = {}

@@ -26,7 +26,8 @@ as in LAMMPS's own 2D dumps: z = 0, iz = 0 and a z extent of one diameter, [0, 1
 3 fixed_wall, 4 floating_wall, 5 driven_wall. The pressure cell is not periodic in y: its y
 boundary is LAMMPS's fixed one (`pp ff pp`), and, as in the trajectory, its y edge is the
 packing's height H, from which the wall particles stick out. Lengths are in d and velocities in
-P d / eta, as stored (divide by J for gammadot d; the channel: a and <u>; docs/units.md), as
+P d / eta, as stored (divide by J for gammadot d; the channel: by channel.mean_velocity for <u>;
+docs/units.md), as
 LAMMPS's `units lj` leaves them: the file states no unit (MDAnalysis will call them Angstrom and
 Angstrom/ps).
 """

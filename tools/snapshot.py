@@ -67,6 +67,15 @@ def section(z, diam, lz, z0):
     return np.concatenate(index), np.concatenate(radius)
 
 
+def drawn_spheres(z, diam, mobile, lz, z0):
+    """What a section of spheres draws: the index of each circle and its radius, the walls' whole
+    spheres first (drawn behind), then the mobile spheres' cuts by the plane z = z0."""
+    cut, radius = section(z, diam, lz, z0)
+    cut, radius = cut[mobile[cut]], radius[mobile[cut]]
+    walls = np.flatnonzero(~mobile)
+    return np.concatenate([walls, cut]), np.concatenate([0.5 * diam[walls], radius])
+
+
 def title_of(run_dir, fr):
     run = rundir.Run(run_dir)
     cfg, summary = run.config, run.summary
@@ -109,11 +118,7 @@ def main():
         if args.z is not None and not 0 <= args.z <= fr["lz"]:
             sys.exit(f"snapshot: --z must lie in [0, {fr['lz']:g}] (the box's z edge), not {args.z:g}")
         z0 = 0.5 * fr["lz"] if args.z is None else args.z
-        cut, radius = section(x[:, 2], diam, fr["lz"], z0)
-        cut, radius = cut[mobile[cut]], radius[mobile[cut]]
-        walls = np.flatnonzero(~mobile)
-        order = np.concatenate([walls, cut])  # the walls first: drawn behind
-        radius = np.concatenate([0.5 * diam[walls], radius])
+        order, radius = drawn_spheres(x[:, 2], diam, mobile, fr["lz"], z0)
         x, x0, mobile = x[order], x0[order], mobile[order]
         title += f", section z = {z0:.3g} d"
     elif args.z is not None:

@@ -59,7 +59,7 @@ only = subprocess.run([sys.executable, str(repo / "tools/results_table.py"), "--
 assert only.splitlines()[0].startswith("| J range |") and full in only.splitlines(), only
 # Spheres (sweep.csv's dimension = 3): their phi law is set against Boyer et al.'s J -> 0 form,
 # phi_m (1 - J^1/2) with phi_m = 0.585, not against the discs' phi_c = 0.81; phi_c = 0.590 +- 0.005
-# is 1.0 standard error from it (44 from 0.81).
+# is 1.0 standard error from it (19.7 combined errors from the discs' 0.81 +- 0.01).
 spheres = work / "spheres"
 spheres.mkdir(exist_ok=True)
 sphere_fits = json.loads((work / "fits.json").read_text())
