@@ -42,7 +42,8 @@ def drift(run_dir, every=5):
     keep = slice(len(t) // 4, None)
     return dict(strain=(float(t[keep][0]), float(t[-1])), slope=float(np.polyfit(t[keep], yc[keep], 1)[0]),
                 velocity=float(vy[keep].mean() / gammadot), implied_drag=float(implied[keep].mean()),
-                drag=float(drag[keep].mean()), implied_by_frame=implied, drag_by_frame=drag)
+                drag=float(drag[keep].mean()), implied_by_frame=implied, drag_by_frame=drag,
+                spheres=edges.shape[1] == 3)
 
 
 def main():
@@ -51,7 +52,7 @@ def main():
     ap.add_argument("--every", type=int, default=5, help="use every K-th frame (default 5)")
     a = ap.parse_args()
     r = drift(a.run, a.every)
-    area = "(Lx Lz)" if rundir.Run(a.run).config.get("scene", {}).get("dimension", 2) == 3 else "(Lx lz)"
+    area = "(Lx Lz)" if r["spheres"] else "(Lx lz)"
     print(f"{a.run}: strain {r['strain'][0]:.1f}-{r['strain'][1]:.1f}")
     print(f"  centre of mass (diameter-weighted) from positions: {r['slope']:+.4f} d per strain")
     print(f"  from the recorded velocities:                      {r['velocity']:+.4f} gammadot d")

@@ -136,9 +136,9 @@ def main():
     fig, ax = plt.subplots(figsize=(6.8, 6 * max(0.3, (yhi - ylo) / lx)))
     y_images = (-1, 0, 1) if fr["periodic_y"] else (0,)
     patches, colours = [], []
+    wall_colour = "0.75" if fr["lz"] is not None else "black"  # spheres' walls lie behind their cuts
     for i in range(len(radius)):
         a = radius[i]
-        wall_colour = "0.75" if fr["lz"] is not None else "black"
         colour = wall_colour if not mobile[i] else cmap(norm(colour_key[i]))
         for ky in y_images:
             cy = x[i, 1] + ky * ly
