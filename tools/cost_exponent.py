@@ -14,34 +14,43 @@ import sys
 import numpy as np
 
 
-def main(path):
-    data = json.load(open(path))
+def families(data):
+    """{family: [(N, real time, cpu time), ...] sorted by N} of one Google Benchmark JSON output."""
     benchmarks = [b for b in data.get("benchmarks", []) if "N" in b]
     runs = [b for b in benchmarks if b.get("run_type") != "aggregate"]
     if not runs:  # --benchmark_report_aggregates_only: the medians of the repetitions
-        runs = [b for b in benchmarks if b.get("aggregate_name") == "median"]
-        for b in runs:
-            b["name"] = b["name"].removesuffix("_median")
+        runs = [dict(b, name=b["name"].removesuffix("_median"))
+                for b in benchmarks if b.get("aggregate_name") == "median"]
     # bench_step labels its variants (the frictional one is fitted); bench_step_3d has one variant.
     labelled = any(b.get("label") for b in runs)
     fams = {}
     for b in runs:
         if labelled and b.get("label") != "frictional":
             continue
-        name = b["name"].split("/")[0]
-        fams.setdefault(name, []).append((b["N"], b["real_time"], b.get("cpu_time", b["real_time"])))
+        fams.setdefault(b["name"].split("/")[0], []).append(
+            (b["N"], b["real_time"], b.get("cpu_time", b["real_time"])))
+    return {name: sorted(pts) for name, pts in fams.items()}
+
+
+def exponent(pts):
+    """b of cpu time = a N^b, least squares in log-log space (nan for a single N)."""
+    if len(pts) < 2:
+        return float("nan")
+    n = np.array([p[0] for p in pts])
+    cpu = np.array([p[2] for p in pts])
+    return np.polyfit(np.log(n), np.log(cpu), 1)[0]
+
+
+def main(path):
+    fams = families(json.load(open(path)))
     if not fams:
         sys.exit(f"cost_exponent: {path} holds no benchmark with an N counter "
                  "(give bench_step's or bench_step_3d's --benchmark_format=json output)")
-    print(f"{'benchmark':24s} " + " ".join(f"{'N=' + str(int(n)):>10s}" for n, _, _ in
-                                           sorted(next(iter(fams.values())))) + "   exponent (cpu)")
-    for name, pts in fams.items():
-        pts.sort()
-        n = np.array([p[0] for p in pts])
-        cpu = np.array([p[2] for p in pts])
-        b = np.polyfit(np.log(n), np.log(cpu), 1)[0] if len(pts) > 1 else float("nan")
-        print(f"{name:24s} " + " ".join(f"{c:8.3f}ms" for c in cpu) + f"   {b:.2f}")
-
+    ns = sorted({p[0] for p in next(iter(fams.values()))})
+    print(f"{'benchmark':24s} " + " ".join(f"{'N=' + str(int(n)):>10s}" for n in ns) + "   exponent (cpu)")
+    for name, pts in fams.items():  # repetitions: the median at each N is shown, all are fitted
+        cells = [np.median([p[2] for p in pts if p[0] == n]) for n in sorted({p[0] for p in pts})]
+        print(f"{name:24s} " + " ".join(f"{c:8.3f}ms" for c in cells) + f"   {exponent(pts):.2f}")
 
 if __name__ == "__main__":
     main(sys.argv[1])

@@ -9,15 +9,16 @@ omega/gammadot and v_y/gammadot, and the mean omega/gammadot (the fluid's is -1/
 omega is the spin about z, the axis of the flow's vorticity). Works on a
 run stopped by a signal (no summary.json) as long as its trajectory is closed.
 """
-import os, sys
+import os
+import sys
 
 import rundir  # tools/rundir.py: what every tool reads of a run
 
 import numpy as np
 
-for arg in sys.argv[1:]:
-    d, lo = (arg.rsplit(':', 1) + ['2'])[:2] if ':' in arg else (arg, '2')
-    lo = float(lo)
+
+def statistics(d, lo=2.0):
+    """The table's row of run directory d over the frames with strain >= lo, as a dict."""
     run = rundir.Run(d)
     with run.open('trajectory') as f:
         o = f['observables']
@@ -35,9 +36,23 @@ for arg in sys.argv[1:]:
         vy = p['velocity/value'][:][:, mobile, 1] / J
     idx = np.where(sel)[0]
     a, b = idx[: len(idx) // 2], idx[len(idx) // 2:]
-    sps = run.summary.get('steps_per_strain', float('nan'))
-    print(f'{os.path.basename(d.rstrip("/")):16s} J {J:.0e} strain {s[-1]:5.1f} window [{lo:g},] '
-          f'phi {phi[sel].mean():.4f} ({phi[a].mean():.4f} {phi[b].mean():.4f})  '
-          f'mu {mu[sel].mean():.3f} ({mu[a].mean():.3f} {mu[b].mean():.3f})  '
-          f'std(omega)/J {w[sel].std(axis=1).mean():5.1f}  std(vy)/J {vy[sel].std(axis=1).mean():4.2f}  '
-          f'<omega>/J {w[sel].mean():+.2f}  steps/strain {sps:.0f}')
+    return {'name': os.path.basename(d.rstrip('/')), 'J': J, 'strain': s[-1], 'from': lo,
+            'phi': (phi[sel].mean(), phi[a].mean(), phi[b].mean()),
+            'mu': (mu[sel].mean(), mu[a].mean(), mu[b].mean()),
+            'std_omega': w[sel].std(axis=1).mean(), 'std_vy': vy[sel].std(axis=1).mean(),
+            'mean_omega': w[sel].mean(),
+            'steps_per_strain': run.summary.get('steps_per_strain', float('nan'))}
+
+
+def row(r):
+    return (f"{r['name']:16s} J {r['J']:.0e} strain {r['strain']:5.1f} window [{r['from']:g},] "
+            f"phi {r['phi'][0]:.4f} ({r['phi'][1]:.4f} {r['phi'][2]:.4f})  "
+            f"mu {r['mu'][0]:.3f} ({r['mu'][1]:.3f} {r['mu'][2]:.3f})  "
+            f"std(omega)/J {r['std_omega']:5.1f}  std(vy)/J {r['std_vy']:4.2f}  "
+            f"<omega>/J {r['mean_omega']:+.2f}  steps/strain {r['steps_per_strain']:.0f}")
+
+
+if __name__ == '__main__':
+    for arg in sys.argv[1:]:
+        d, lo = arg.rsplit(':', 1) if ':' in arg else (arg, '2')
+        print(row(statistics(d, float(lo))))
