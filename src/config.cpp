@@ -254,7 +254,7 @@ const std::vector<KeySpec>& schema() {
     s.push_back(real("integrator.explicit_safety", &C::integrator, &C::Integrator::explicit_safety,
                      0.0, 1.0, true, "",
                      "Explicit integrators: dt is at most this fraction of the contact "
-                     "stability limit 2 R/k."));
+                     "stability limit 2 R/k of the densest packing (docs/model.md section 7)."));
     s.push_back(choice(
         "solver.cholesky", {"cholmod", "eigen"},
         "Sparse Cholesky of the per-step system: `cholmod` (CHOLMOD supernodal, default: "

@@ -19,7 +19,7 @@ double interaction_range_factor(const Config& cfg) {
 }
 
 double explicit_stability_dt(const Config& cfg) {
-  return PairLaws::from(cfg).explicit_stability_dt();
+  return PairLaws::from(cfg).explicit_stability_dt(cfg.scene.dimension);
 }
 
 bool rotational_unknowns(const Config& cfg) {
@@ -33,7 +33,8 @@ void validate_run_inputs(const Config& cfg, const std::string& origin) {
     if (cfg.integrator.dt >= limit)
       throw ConfigError(fmt::format(
           "{}: integrator.dt: fixed dt = {} is not below the stability limit 2 R/k = {:.3g} "
-          "eta/P of explicit springs (smallest pair, normal and slip modes, "
+          "eta/P of explicit springs (smallest particles in their densest packing, normal and "
+          "slip modes, "
           "docs/model.md section 7; integrator.type = \"{}\", contact.ktilde = {}); use "
           "integrator.dt < "
           "{:.3g}, integrator.dt = 0 (adaptive), or "

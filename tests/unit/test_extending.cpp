@@ -223,9 +223,10 @@ TEST(ExtendingExample, APairLawWrittenOutsideTheLibrary) {
                                                                 Corona::from(p));
   EXPECT_DOUBLE_EQ(laws.range_factor(), 1.05);  // the neighbour list's cut-off follows it
   EXPECT_FALSE(laws.needs_rotations());
-  // Explicit stability limit 2 R / k of the smallest pair, R the drag of two discs of radius
-  // 1/2 in series, 3 pi eta d / 2 (docs/model.md section 7).
-  EXPECT_NEAR(laws.explicit_stability_dt(), 2.0 * (3.0 * kPi / 2.0) / 100.0, 1e-12);
+  // Explicit stability limit 2 R / k, R the drag of two discs of radius 1/2 in series,
+  // 3 pi eta d / 2, shared among the contacts of a disc in the densest packing (5, docs/model.md
+  // section 7): the corona adds stiffness and no damping.
+  EXPECT_NEAR(laws.explicit_stability_dt(2), 2.0 * (3.0 * kPi / 2.0 / 5.0) / 100.0, 1e-12);
 
   // Two small discs with coronas overlapping by 0.02 d: the pair's force is k 0.02 along the line
   // of centres, pushing them apart, and the implicit block is dt k m m^T.
