@@ -404,7 +404,8 @@ class StepLoop {
       if (auto r = run_.health.check(d, sim.integrator().velocities(), sim.integrator().last_dt()))
         stop(*r);
       const StressSample s = sim.sample();
-      const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt()};
+      const StepView view{d, sim.integrator().velocities(), s, sim.integrator().last_dt(),
+                          sim.integrator().stages(d)};
       for (const auto& o : run_.observers) o->on_step(view);
       if (d.strain() >= run_.next_frame * (1.0 - 1e-12)) output_frame(view);
       show_progress();
@@ -427,7 +428,8 @@ class StepLoop {
     if (!sim.solve_at_rest())
       stop(run_.health.solver_failure(sim.dynamics(), sim.integrator().velocities()));
     const StressSample s = sim.sample_at_rest();
-    write_frame(StepView{sim.dynamics(), sim.integrator().velocities(), s, 0.0});
+    write_frame(StepView{sim.dynamics(), sim.integrator().velocities(), s, 0.0,
+                         sim.integrator().stages(sim.dynamics())});
   }
 
   // A frame: observers add their values, the trajectory writes it, a checkpoint may follow.

@@ -80,30 +80,31 @@ template StressSample measure_stress(const Dynamics3&, const std::vector<PairTer
                                      const VelocitiesOf<Dim3>&, double);
 
 template <class D>
-double normal_load_between(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y1, double y2,
-                           double lz) {
+double normal_load_between(const DynamicsOf<D>& d, const std::vector<StageOf<D>>& stages, double y1,
+                           double y2, double lz) {
   if (!(y2 > y1)) return 0.0;
   const auto& pairs = d.neighbours().pairs();
-  const auto& terms = d.force_balance().terms();
   const auto& p = d.particles();
   double load = 0.0;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const auto& t = terms[k];
-    if (!t.on) continue;
-    const auto& pr = pairs[k];
-    const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y();
-    if (mid < y1 || mid >= y2) continue;
-    // Lever arm r (not the stress convention's s for open pairs): sum of dy_ij f_y over the
-    // band's pairs is exactly the band's mean of the force across a horizontal line.
-    const double fjy = t.force(v.u[pr.i], v.u[pr.j])(D::body + 1);
-    load += t.g.r * t.g.n.y() * fjy;
-  }
+  for (const StageOf<D>& stage : stages)
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const auto& t = (*stage.terms)[k];
+      if (!t.on) continue;
+      const auto& pr = pairs[k];
+      const double mid = p.position[pr.i].y() + 0.5 * t.g.r * t.g.n.y();
+      if (mid < y1 || mid >= y2) continue;
+      // Lever arm r (not the stress convention's s for open pairs): sum of dy_ij f_y over the
+      // band's pairs is exactly the band's mean of the force across a horizontal line.
+      const auto& u = stage.velocities->u;
+      load += stage.weight * t.g.r * t.g.n.y() * t.force(u[pr.i], u[pr.j])(D::body + 1);
+    }
   return load / (horizontal_area(d, lz) * (y2 - y1));
 }
 
-template double normal_load_between(const Dynamics&, const Velocities&, double, double, double);
-template double normal_load_between(const Dynamics3&, const VelocitiesOf<Dim3>&, double, double,
-                                    double);
+template double normal_load_between(const Dynamics&, const std::vector<StageOf<Dim2>>&, double,
+                                    double, double);
+template double normal_load_between(const Dynamics3&, const std::vector<StageOf<Dim3>>&, double,
+                                    double, double);
 
 namespace {
 

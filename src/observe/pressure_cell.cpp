@@ -199,7 +199,7 @@ void PressureCellObserverOf<D>::on_frame(const StepView& v, std::vector<double>&
   // The walls' load difference is the y drag of the fluid on the discs: positive when they sink.
   const double drag = (v.stress.top_wall_fy + v.stress.bottom_wall_fy) / a / pressure_;
   const auto [y1, y2] = bulk_band(d, exclusion_);
-  const double load = normal_load_between(d, v.velocities, y1, y2, lz_) / pressure_;
+  const double load = normal_load_between(d, v.stages, y1, y2, lz_) / pressure_;
   values.insert(values.end(), {h, phi, mu_top, mu_bottom, v.stress.top_wall_fy / a,
                                v.velocities.wall_v, drag, load});
   // The measured window's frames: from the one at which steady state is detected on, the

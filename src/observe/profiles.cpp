@@ -77,8 +77,8 @@ typename D::Point lubrication_force_on_j(const Lubrication& law, const PairTermO
 }  // namespace
 
 template <class D>
-void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double yb, double lz,
-                             double weight) {
+void GapProfiles::add_stress(const DynamicsOf<D>& d, const std::vector<StageOf<D>>& stages,
+                             double yb, double lz, double weight) {
   const auto bins = static_cast<long>(w_.size());
   if (bins == 0) return;
   const auto& lubrication = d.force_balance().lubrication();
@@ -86,8 +86,17 @@ void GapProfiles::add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, d
   if (lubrication)
     for (auto* vec : {&sxy_lub_, &sp_lub_}) vec->resize(w_.size(), 0.0);
   const double volume = horizontal_area(d, lz) * bin_;
+  for (const StageOf<D>& stage : stages)
+    add_stage_stress(d, *stage.terms, *stage.velocities, yb, volume, weight * stage.weight);
+}
+
+template <class D>
+void GapProfiles::add_stage_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf<D>>& terms,
+                                   const VelocitiesOf<D>& v, double yb, double volume,
+                                   double weight) {
+  const auto bins = static_cast<long>(w_.size());
+  const auto& lubrication = d.force_balance().lubrication();
   const auto& pairs = d.neighbours().pairs();
-  const auto& terms = d.force_balance().terms();
   const auto& p = d.particles();
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto& t = terms[k];
@@ -115,9 +124,10 @@ template void GapProfiles::add(const Particles&, const std::vector<Vec3>&, doubl
                                double);
 template void GapProfiles::add(const Particles3&, const std::vector<Vec6>&, double, double, double,
                                double);
-template void GapProfiles::add_stress(const Dynamics&, const Velocities&, double, double, double);
-template void GapProfiles::add_stress(const Dynamics3&, const VelocitiesOf<Dim3>&, double, double,
-                                      double);
+template void GapProfiles::add_stress(const Dynamics&, const std::vector<StageOf<Dim2>>&, double,
+                                      double, double);
+template void GapProfiles::add_stress(const Dynamics3&, const std::vector<StageOf<Dim3>>&, double,
+                                      double, double);
 
 Eigen::MatrixXd GapProfiles::table() const {
   const auto nb = static_cast<Eigen::Index>(w_.size());
@@ -182,7 +192,7 @@ void ProfilesObserverOf<D>::on_step(const StepView& v) {
   w_ += w;
   h_ += w * d.height();
   profiles_.add(d.particles(), v.velocities.u, yb, d.height(), band_section(d), w);
-  profiles_.add_stress(d, v.velocities, yb, lz_, w);
+  profiles_.add_stress(d, v.stages, yb, lz_, w);
 }
 
 template <class D>

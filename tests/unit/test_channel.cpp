@@ -199,7 +199,8 @@ TEST(Channel, ProgressReportsTheLastIntervalOfTheHistory) {
   while (d.strain() < 4.5) {
     sim.step();
     const StressSample s = sim.sample();
-    obs.on_step(StepView{d, sim.integrator().velocities(), s, sim.integrator().last_dt()});
+    obs.on_step(StepView{d, sim.integrator().velocities(), s, sim.integrator().last_dt(),
+                         sim.integrator().stages(d)});
   }
   const std::string text = obs.progress();
   const ChannelHistory h = obs.history(d);

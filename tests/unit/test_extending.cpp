@@ -57,8 +57,8 @@ void drive(Simulation& sim, Observer& o, int steps) {
   for (int k = 0; k < steps; ++k) {
     ASSERT_TRUE(sim.try_step());
     const StressSample s = sim.sample();
-    o.on_step(
-        StepView{sim.dynamics(), sim.integrator().velocities(), s, sim.integrator().last_dt()});
+    o.on_step(StepView{sim.dynamics(), sim.integrator().velocities(), s, sim.integrator().last_dt(),
+                       sim.integrator().stages(sim.dynamics())});
   }
 }
 
@@ -137,7 +137,8 @@ TEST(ExtendingExample, ASceneWrittenOutsideTheLibrary) {
   for (int k = 0; k < 200; ++k) {
     ASSERT_TRUE(sim.try_step());
     const StressSample s = sim.sample();
-    const StepView v{sim.dynamics(), sim.integrator().velocities(), s, sim.integrator().last_dt()};
+    const StepView v{sim.dynamics(), sim.integrator().velocities(), s, sim.integrator().last_dt(),
+                     sim.integrator().stages(sim.dynamics())};
     for (auto& o : observers) o->on_step(v);
   }
   // Closed form: u_x = gammadot (y - y0), u_y = 0 and omega = -gammadot / 2 for each disc (the

@@ -34,6 +34,10 @@ class IntegratorOf {
   virtual StressSample sample(const Dynamics& d, double lz) const {
     return measure_stress(d, last_, lz);
   }
+  // The last step's solves with their shares of its motion (what observers sum pair forces over).
+  virtual std::vector<StageOf<D>> stages(const Dynamics& d) const {
+    return {{&d.force_balance().terms(), &last_, 1.0}};
+  }
   // Whether the springs sit inside the matrix (the force balance must keep the full pattern).
   virtual bool implicit_springs() const { return false; }
   // Step-size memory and counters, for checkpoints.
@@ -74,6 +78,10 @@ class HeunOf final : public IntegratorOf<D> {
   StressSample sample(const Dynamics& d, double lz) const override {
     return average(measure_stress(d, predictor_terms_, predictor_, lz),
                    measure_stress(d, corrector_terms_, corrector_, lz));
+  }
+  std::vector<StageOf<D>> stages(const Dynamics& d) const override {
+    if (predictor_terms_.empty()) return IntegratorOf<D>::stages(d);  // at rest: one solve
+    return {{&predictor_terms_, &predictor_, 0.5}, {&corrector_terms_, &corrector_, 0.5}};
   }
 
  private:

@@ -47,6 +47,17 @@ double pair_lever_arm(const Geometry& g, bool touching) {
   return touching ? g.r : g.s;
 }
 
+// One solve of a step: its pair terms, the velocities it gave and its share of the step's motion.
+// A step moves the particles with the weighted sum of its stages' velocities (one stage, weight
+// 1, for Euler and implicit springs; predictor and corrector, 1/2 each, for Heun), so a pair sum
+// over forces is that weighted sum of each stage's own terms times its own velocities.
+template <class D>
+struct StageOf {
+  const std::vector<PairTermOf<D>>* terms;
+  const VelocitiesOf<D>* velocities;
+  double weight;
+};
+
 // Discs or spheres; lz is a monolayer's thickness (spheres: the cell's own lz is used).
 template <class D>
 StressSample measure_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double lz);
@@ -58,10 +69,11 @@ StressSample measure_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf
 // pairs whose midpoints lie between heights y1 < y2 of (y_j - y_i) f_y on j, over the band's
 // area (-sigma_yy with the lever arm r for every pair). Where nothing moves on average in y,
 // momentum balance makes it equal the load on the walls at every height; a packing that
-// dilates from its middle carries more than P there though its net drag is zero.
+// dilates from its middle carries more than P there though its net drag is zero. Summed over
+// the step's stages.
 template <class D>
-double normal_load_between(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y1, double y2,
-                           double lz);
+double normal_load_between(const DynamicsOf<D>& d, const std::vector<StageOf<D>>& stages, double y1,
+                           double y2, double lz);
 
 // The area a force across a horizontal plane is spread over: lx lz, lz the monolayer's
 // thickness for discs and the periodic cell's depth for spheres.

@@ -25,6 +25,8 @@ struct StepViewOf {
   const VelocitiesOf<D>& velocities;
   const StressSample& stress;
   double dt;
+  // The step's solves (IntegratorOf::stages): pair sums over forces run over them.
+  std::vector<StageOf<D>> stages;
 };
 
 // Reads the state after steps; never changes it. A run composes only the observers its scene

@@ -35,9 +35,10 @@ class GapProfiles {
   // The pair stresses of the step (sigma = -sum l n f / V): each pair's share in the bin of its
   // midpoint; lz: the monolayer's thickness (discs). With lubrication, also the part of them
   // its forces make (the rest is the contacts' springs, and the repulsion where it is on).
+  // Summed over the step's stages (StageOf), each with its own pair terms and velocities.
   template <class D>
-  void add_stress(const DynamicsOf<D>& d, const VelocitiesOf<D>& v, double y_bottom, double lz,
-                  double weight);
+  void add_stress(const DynamicsOf<D>& d, const std::vector<StageOf<D>>& stages, double y_bottom,
+                  double lz, double weight);
   bool empty() const { return w_.empty(); }
   // Rows = bins; columns y (bin centre), phi, u_x, T.
   Eigen::MatrixXd table() const;
@@ -61,6 +62,9 @@ class GapProfiles {
   }
 
  private:
+  template <class D>
+  void add_stage_stress(const DynamicsOf<D>& d, const std::vector<PairTermOf<D>>& terms,
+                        const VelocitiesOf<D>& v, double y_bottom, double volume, double weight);
   void grow(std::size_t bins);
   double bin_, section_ = 1.0;  // the cell's extent normal to y (lx, or lx lz for spheres)
   std::vector<double> w_, area_, n_, ux_, ux2_, uy2_, sxy_, sp_;
