@@ -106,7 +106,8 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
             "disc area in the slab `observables.wall_exclusion` inside the wall lines over the "
             "slab's area, time-averaged over the measured window (if not steady: of the last "
             "configuration). Channel: mobile disc area / (Lx (H + d)), over the wall rows' centre "
-            "lines, not channel.phi"},
+            "lines, not channel.phi. Spheres: volume fraction, sphere volumes (cut exactly by the "
+            "slab's planes) over Lx Lz times the slab's height"},
        }},
       {"The pressure cell: steady state and window means",
        "The steady-state detector and the measured window are described in docs/model.md "
@@ -139,9 +140,11 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
            {sk::mu_err, "1",
             "standard error of mu (batch means of the per-frame (mu_top + mu_bottom) / 2)"},
            {sk::mu_top, "1",
-            "-F_top,x / (P Lx l_z): shear force of the suspension on the top wall over its load"},
+            "-F_top,x / (P Lx l_z), spheres P Lx Lz: shear force of the suspension on the top "
+            "wall over its load"},
            {sk::mu_top_err, "1", "standard error of mu_top (batch means)"},
-           {sk::mu_bottom, "1", "+F_bottom,x / (P Lx l_z): the same on the bottom wall"},
+           {sk::mu_bottom, "1",
+            "+F_bottom,x / (P Lx l_z), spheres P Lx Lz: the same on the bottom wall"},
            {sk::mu_bottom_err, "1", "standard error of mu_bottom (batch means)"},
            {sk::steady_errors_note, "-",
             "present instead of the five `*_err` keys above when the window has fewer than 8 "
@@ -201,11 +204,13 @@ std::vector<SummaryKeyGroup> summary_key_groups() {
            {sk::profile_bin, "d", "bin width"},
            {sk::profile_y, "d", "array: bin centres above the bottom wall's centre line"},
            {sk::profile_phi, "1",
-            "array: area fraction, each disc's exact area in each bin over the bin's area"},
+            "array: area fraction, each disc's exact area in each bin over the bin's area "
+            "(spheres: volume fraction, each sphere's exact volume in the bin over Lx Lz bin)"},
            {sk::profile_u_x, "gammadot d",
             "array: mean x velocity of the discs whose centres are in the bin, over gammadot"},
            {sk::profile_T, "(gammadot d)^2",
-            "array: <u_x^2> - <u_x>^2 + <u_y^2> of those discs, over gammadot^2"},
+            "array: <u_x^2> - <u_x>^2 + <u_y^2> of those discs, over gammadot^2 (spheres: the "
+            "same x-y part; u_z is not counted)"},
            {sk::profile_shear_stress, "P",
             "array: sigma_xy of the pair forces, each pair in the bin of its midpoint, over the "
             "bin's volume Lx bin l_z"},

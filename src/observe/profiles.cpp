@@ -169,7 +169,7 @@ void GapProfiles::to_summary(nlohmann::json& js, double gammadot, double height,
       sp[b] = w_[b] > 0 ? sp_[b] / w_[b] : 0.0;
     }
     js[summary_key::profile_shear_stress] = sxy;  // sigma_xy of the pair forces, P
-    js[summary_key::profile_pressure] = sp;  // -(sigma_xx + sigma_yy) / 2 of the pair forces, P
+    js[summary_key::profile_pressure] = sp;  // minus the trace over 2 (discs) or 3 (spheres), P
   }
   if (sxy_lub_.size() == w_.size() && !lubrication_partial_) {
     std::vector<double> sxy(w_.size()), sp(w_.size());
