@@ -156,6 +156,39 @@ TEST(ProfilesObserver, LubricationPartOfTheStressOfSpheres) {
   expect_lubrication_part<Dim3>(cfg, 100);
 }
 
+// The same for spheres: the bins' stresses add up to the cell's (Lx Lz bin volumes, the trace
+// over 3), and their volume fractions to the mobile spheres' volume over Lx Lz (each sphere's
+// caps cut exactly by the bin planes).
+TEST(ProfilesObserver, SpheresBinsAddUpToTheCell) {
+  Config cfg = cell_config("pressure_shear");
+  cfg.scene.dimension = 3;
+  cfg.particles.n = 64;
+  cfg.particles.phi_init_spheres = 0.5;
+  cfg.contact.ktilde = 1e3;
+  Simulation3 sim(cfg);
+  for (int k = 0; k < 100; ++k) sim.step();
+  const Dynamics3& d = sim.dynamics();
+  ProfilesObserverOf<Dim3> profiles(cfg, [](const Dynamics3&) { return true; });
+  const StressSample s = sim.sample();
+  profiles.on_step(
+      StepViewOf<Dim3>{d, sim.integrator().velocities(), s, 1.0, sim.integrator().stages(d)});
+  nlohmann::json js;
+  profiles.finish(d, js, nullptr);
+  const double bin = cfg.observables.profile_bin, h = d.height();
+  const auto sum = [&](const char* key) {
+    const auto v = js[key].get<std::vector<double>>();
+    return std::accumulate(v.begin(), v.end(), 0.0) * bin;
+  };
+  ASSERT_TRUE(s.spheres);
+  EXPECT_NEAR(sum("profile_shear_stress"), s.shear_stress() * h,
+              1e-10 * std::abs(s.pressure() * h));
+  EXPECT_NEAR(sum("profile_pressure"), s.pressure() * h, 1e-10 * std::abs(s.pressure() * h));
+  double volume = 0.0;
+  const auto& p = d.particles();
+  for (std::size_t i = 0; i < p.n_mobile; ++i) volume += 4.0 / 3.0 * kPi * std::pow(p.radius[i], 3);
+  EXPECT_NEAR(sum("profile_phi") * d.box().lx * d.box().lz, volume, 1e-9 * volume);
+}
+
 // Without lubrication there is no lubrication part to report.
 TEST(ProfilesObserver, NoLubricationPartWithoutLubrication) {
   Config cfg = cell_config("pressure_shear");
