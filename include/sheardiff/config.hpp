@@ -54,7 +54,7 @@ struct Config {
     double max_overlap_change = 0.0;  // 0 = overlap_change_limit(): from the contact stiffness
     double max_entry_overlap = 0.0;   // 0 = off: only the gap limit bounds a closing pair
     double max_strain_step = 1e-2;
-    double explicit_safety = 0.73;  // the step of 0.5 x the lone pair's limit (docs/model.md 7)
+    double explicit_safety = 0.5;
   } integrator;
   struct Solver {
     std::string cholesky = "cholmod";

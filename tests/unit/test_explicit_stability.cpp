@@ -107,7 +107,7 @@ Config config(int dimension, Lubricated lubricated, double kt_ratio) {
 
 // For every law mix the limit is stable on the lattice (lambda dt_stab <= 2) and not needlessly
 // small (lambda dt_stab >= 0.85: the drag-bound normal mode of spheres is the most conservative
-// case, 0.89); the default explicit_safety keeps lambda dt below 1.5 (1.44 at most). Lubrication
+// case, 0.89); the default explicit_safety keeps lambda dt below 1 (0.99 at most). Lubrication
 // with its squeeze mode only leaves the slip mode drag-bound, as no lubrication does.
 TEST(ExplicitStability, TheLimitHoldsOnTheDensestLattices) {
   for (const Lattice& l : {triangular(), fcc()})
@@ -124,7 +124,7 @@ TEST(ExplicitStability, TheLimitHoldsOnTheDensestLattices) {
                                         << ": lambda " << rate << ", dt_stab " << dt);
         EXPECT_LE(rate * dt, 2.0);
         EXPECT_GE(rate * dt, 0.85);
-        EXPECT_LT(rate * c.integrator.explicit_safety * dt, 1.5);
+        EXPECT_LT(rate * c.integrator.explicit_safety * dt, 1.0);
       }
 }
 

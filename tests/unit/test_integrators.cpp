@@ -107,7 +107,7 @@ TEST(Integrators, ImplicitAndExplicitAgreeAsDtShrinks) {
   const double dt_stab = explicit_stability_dt(base);
   const double t_end = 0.02 / base.flow.j;
   const std::vector<double> dts = {0.02, 0.01, 0.005};
-  ASSERT_LE(dts.front(), base.integrator.explicit_safety * dt_stab);
+  ASSERT_LE(dts.front(), 0.75 * dt_stab);  // explicit springs stable with a margin
 
   std::vector<double> d_ih, d_eh;
   double path_na = 0.0;
