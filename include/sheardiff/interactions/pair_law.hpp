@@ -19,7 +19,8 @@
 //                                  over a step, at the geometry of its start, pair velocity u;
 //   void cap(History&, const PairGeometry&) const;   the history's limit at the end of the step;
 //   void add_stability(double a, StabilityTerms&) const;   its stiffness and damping on the
-//                                  smallest pair (radius a) for the explicit stability limit;
+//                                  smallest pair (radius a) for the explicit stability limit
+//                                  (PairLaws::explicit_stability_dt adds the shared drag);
 //   bool needs_rotations() const;  whether it couples rotation to translation.
 // Every operation that takes a PairGeometry also takes a PairGeometry3 (two spheres), with
 // PairBlock3, a pair velocity Vec12 and its history in three dimensions (a law that keeps one
@@ -65,8 +66,9 @@ struct PairBlockOf {
 using PairBlock = PairBlockOf<Mat6, Vec6>;
 using PairBlock3 = PairBlockOf<Mat12, Vec12>;
 
-// What sets the explicit stability limit 2 R / k of the smallest pair: the normal and tangential
-// stiffness of its laws and their damping (plus the drag) at contact.
+// What sets the explicit stability limit 2 R / k: the normal and tangential stiffness of the
+// smallest pair's laws and their damping at contact (plus its drag, shared among the contacts of
+// the densest packing).
 struct StabilityTerms {
   double normal_damping = 0.0, tangential_damping = 0.0;
   double normal_stiffness = 0.0, tangential_stiffness = 0.0;
